@@ -1,0 +1,22 @@
+# The ROS-free core: Eigen and yaml-cpp only. catkin's include path is deliberately absent,
+# so a ROS header cannot compile here.
+add_library(variational_formation_core
+  src/core/formation.cpp
+  src/core/variational_update.cpp
+  src/core/integrator.cpp
+  src/core/variational_integrator.cpp
+  src/core/explicit_integrators.cpp
+  src/core/metrics.cpp
+  src/core/stability.cpp
+  src/core/scenario.cpp
+  src/core/simulation.cpp
+)
+target_include_directories(variational_formation_core PUBLIC
+  $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/include>)
+target_include_directories(variational_formation_core SYSTEM PUBLIC ${EIGEN3_INCLUDE_DIR})
+target_link_libraries(variational_formation_core PUBLIC yaml-cpp)
+target_compile_options(variational_formation_core PRIVATE ${VF_FLAGS})
+set_target_properties(variational_formation_core PROPERTIES POSITION_INDEPENDENT_CODE ON)
+install(TARGETS variational_formation_core
+  ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})

@@ -1,0 +1,95 @@
+#pragma once
+
+#include <utility>
+#include <vector>
+
+#include "variational_formation/core/types.hpp"
+
+namespace vf {
+
+/// An undirected edge (i, j) of the sensing graph with its desired distance d_ij.
+struct Edge {
+  int tail;
+  int head;
+  double desiredDistance;
+  double desiredDistanceSquared;
+};
+
+/// Agent j seen from agent i: the neighbour's index and d_ij^2.
+struct Neighbour {
+  int agent;
+  double desiredDistanceSquared;
+};
+
+/**
+ * Distance-based formation (paper Section 6.1): n agents in R^d, an undirected edge set E and
+ * a desired shape q*. Desired distances are d_ij = |q*_i - q*_j|.
+ *
+ * Potential V(q) = 1/4 sum_{(i,j) in E} (|q_i - q_j|^2 - d_ij^2)^2 (paper eq. (eq: Vij)).
+ */
+class Formation {
+ public:
+  /**
+   * @param dimension d, 2 or 3.
+   * @param desiredShape d x n matrix of desired positions q*.
+   * @param edges pairs (i, j) of distinct existing agents, no duplicates.
+   * @throws InvalidInput if any of these is violated.
+   */
+  Formation(int dimension, Positions desiredShape, const std::vector<std::pair<int, int>>& edges);
+
+  int dimension() const { return dimension_; }
+  int agentCount() const { return static_cast<int>(desiredShape_.cols()); }
+  const std::vector<Edge>& edges() const { return edges_; }
+  /// N_i in the order the edges are listed; both update paths sum gradients in this order.
+  const std::vector<Neighbour>& neighbours(int agent) const { return neighbours_[agent]; }
+  const Positions& desiredShape() const { return desiredShape_; }
+
+  /// V(q), DESIGN.md §1.
+  double potential(const Positions& q) const;
+  /// 1/2 sum_{j in N_i} V_ij(q): each edge's potential split half to each endpoint.
+  double agentPotential(int agent, const Positions& q) const;
+
+  /**
+   * grad_i V = sum_{j in N_i} (|q_i - q_j|^2 - d_ij^2)(q_i - q_j) (DESIGN.md §1; the paper's
+   * Gamma_ij with its erratum fixed). Reads only column i and the columns of N_i, so the
+   * agent node and the centralised run call this very function on the same numbers.
+   * @param out d doubles.
+   */
+  void agentGradient(int agent, const Positions& q, double* out) const;
+  /// Stacked gradient, d x n, agent by agent through agentGradient.
+  void gradient(const Positions& q, Positions& out) const;
+  /// Hessian of V, (dn) x (dn), with agent i in rows/columns [d i, d i + d).
+  Eigen::MatrixXd hessian(const Positions& q) const;
+
+  /// Rigidity matrix R(q), |E| x dn: row (i,j) holds (q_i - q_j)^T at i and -(q_i - q_j)^T at j.
+  Eigen::MatrixXd rigidityMatrix(const Positions& q) const;
+  /// Numerical rank of R(q).
+  int rigidityRank(const Positions& q) const;
+  /// rank R = dn - d(d+1)/2 (2n-3 in 2D, 3n-6 in 3D), for n >= d + 1.
+  bool isInfinitesimallyRigid(const Positions& q) const;
+  /// Infinitesimally rigid and |E| = dn - d(d+1)/2.
+  bool isMinimallyRigid(const Positions& q) const;
+
+  /// Per edge |q_i - q_j| - d_ij, in the order of edges().
+  Eigen::VectorXd distanceErrors(const Positions& q) const;
+  /// max_e |distance error_e|, 0 without edges.
+  double maxDistanceError(const Positions& q) const;
+
+  /**
+   * Congruence (paper Section 6.2): every pairwise distance, over all pairs, is within
+   * tolerance (relative) of the desired shape's and every agent's speed is below maxSpeed.
+   */
+  bool isCongruent(const Positions& q, const Positions& v, double tolerance = 0.01,
+                   double maxSpeed = 0.1) const;
+
+ private:
+  int dimension_;
+  Positions desiredShape_;
+  std::vector<Edge> edges_;
+  std::vector<std::vector<Neighbour>> neighbours_;
+};
+
+/// The number dn - d(d+1)/2 of independent edges a rigid framework of n >= d+1 agents needs.
+int rigidEdgeCount(int dimension, int agentCount);
+
+}  // namespace vf

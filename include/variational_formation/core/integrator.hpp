@@ -1,0 +1,68 @@
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "variational_formation/core/formation.hpp"
+#include "variational_formation/core/variational_update.hpp"
+
+namespace vf {
+
+/// Which scheme integrates the closed loop q'' = -kappa q' - grad V (paper eq. (formation3)).
+enum class Method { Variational, ExplicitEuler, RungeKutta4 };
+
+/// "vi", "euler", "rk4" -> Method. @throws InvalidInput naming `field`.
+Method parseMethod(const std::string& text, const std::string& field = "--method");
+std::string methodName(Method method);
+/// "variational", "paper" -> StartMethod. @throws InvalidInput naming `field`.
+StartMethod parseStartMethod(const std::string& text, const std::string& field = "--init");
+
+/**
+ * A one-step view of every integrator: state at step k, advanced by step(). The step index
+ * k starts at 0 with the initial positions; time is k h.
+ */
+class Integrator {
+ public:
+  virtual ~Integrator() = default;
+
+  /// Advances from step k to step k + 1.
+  virtual void step() = 0;
+  /// q_k, d x n.
+  virtual const Positions& positions() const = 0;
+  /// Velocity at step k: v_{k-1} = (q_k - q_{k-1})/h for the variational scheme (v_0 at k = 0).
+  virtual Positions velocities() const = 0;
+  /// Unweighted momentum at step k: p+_k for the variational scheme (v_0 at k = 0), v_k else.
+  virtual Positions momenta() const = 0;
+  /// Energy at step k: the discrete energy E_d(q_{k-1}, q_k) for the variational scheme,
+  /// 1/2|v|^2 + V(q) otherwise (and at k = 0).
+  virtual double energy() const = 0;
+
+  long stepIndex() const { return step_; }
+  double time() const { return static_cast<double>(step_) * timeStep_; }
+  double timeStep() const { return timeStep_; }
+  double dampingGain() const { return dampingGain_; }
+  const Formation& formation() const { return formation_; }
+
+ protected:
+  Integrator(const Formation& formation, double timeStep, double dampingGain)
+      : formation_(formation), timeStep_(timeStep), dampingGain_(dampingGain) {}
+
+  const Formation& formation_;
+  double timeStep_;
+  double dampingGain_;
+  long step_ = 0;
+};
+
+/**
+ * Builds an integrator. The formation must outlive it.
+ * @param q0 initial positions, @param v0 initial velocities (d x n each).
+ * @param timeStep h > 0 [s]. @param dampingGain kappa >= 0 [1/s].
+ * @param start only used by Method::Variational.
+ * @throws InvalidInput on bad sizes or values.
+ */
+std::unique_ptr<Integrator> makeIntegrator(Method method, const Formation& formation,
+                                           const Positions& q0, const Positions& v0,
+                                           double timeStep, double dampingGain,
+                                           StartMethod start = StartMethod::Variational);
+
+}  // namespace vf

@@ -1,0 +1,45 @@
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "variational_formation/core/formation.hpp"
+
+namespace vf {
+
+/**
+ * One scenario file (DESIGN.md §4). Loaded and checked by one path, shared by the CLIs and the
+ * nodes. Positions are d x n, agents in id order.
+ */
+struct Scenario {
+  std::string name;
+  int dimension = 0;
+  double dampingGain = 0.0;  ///< kappa [1/s]
+  double timeStep = 0.0;     ///< h [s]
+  long steps = 0;            ///< number of updates; 0 = unbounded (ROS run only)
+  Positions initialPositions;
+  Positions initialVelocities;
+  Positions desiredPositions;
+  std::vector<std::pair<int, int>> edges;
+  /// Non-fatal findings, one line each (a non-rigid desired graph, a too large h).
+  std::vector<std::string> warnings;
+
+  int agentCount() const { return static_cast<int>(initialPositions.cols()); }
+};
+
+/// Reads and validates a scenario file. @throws InvalidInput "<file>: <field>: <problem>".
+Scenario loadScenario(const std::string& path);
+/// Parses and validates YAML text; `source` prefixes error messages.
+Scenario parseScenario(const std::string& yamlText, const std::string& source);
+/**
+ * Checks the numeric fields (after command-line overrides too): finite kappa >= 0, h > 0,
+ * steps >= 0 (>= 1 if requireBoundedSteps). Recomputes the warnings.
+ * @throws InvalidInput naming the field.
+ */
+void validateScenario(Scenario& scenario, bool requireBoundedSteps = false);
+
+/// The formation (desired shape and edges) of a validated scenario.
+Formation makeFormation(const Scenario& scenario);
+
+}  // namespace vf

@@ -1,0 +1,53 @@
+# Shared by demo.sh, test.sh and the benchmarks: installs the Debian packages the package
+# needs, lays out a catkin workspace inside the repository (.ws, git-ignored) and builds it.
+# Source it; it defines REPO, WS and the functions below.
+set -euo pipefail
+REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+WS="$REPO/.ws"
+# Debian's ROS lives in /usr; a pyenv python3 earlier on PATH has no ROS modules.
+export PATH="/usr/bin:/bin:/usr/sbin:/sbin:$PATH"
+export ROS_HOME="${ROS_HOME:-$HOME/.ros}"
+
+VF_APT_PACKAGES=(
+  build-essential cmake catkin ros-core-dev ros-base-dev libroscpp-dev libtf2-ros-dev
+  ros-geometry-msgs ros-visualization-msgs ros-std-msgs ros-message-generation ros-message-runtime
+  ros-tf2-msgs librosbag-dev python3-rosbag python3-rostest librostest-dev python3-roslaunch
+  rosbash rviz libeigen3-dev libyaml-cpp-dev libgtest-dev googletest libbenchmark-dev
+  python3-matplotlib python3-numpy python3-yaml xvfb x11-utils python3-tf2-ros
+)
+
+vf_install_dependencies() {
+  local missing=()
+  local p
+  for p in "${VF_APT_PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  echo "installing ${#missing[@]} Debian packages: ${missing[*]}"
+  local sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends \
+    "${missing[@]}" >/dev/null
+}
+
+vf_build() {
+  mkdir -p "$WS/src"
+  ln -sfn "$REPO" "$WS/src/variational_formation"
+  local jobs
+  jobs="$(nproc 2>/dev/null || echo 2)"
+  (cd "$WS" && catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 \
+      -DCMAKE_BUILD_TYPE=Release "$@" -j"$jobs" >"$WS/build.log" 2>&1) || {
+    tail -n 60 "$WS/build.log"
+    echo "build failed; full log: $WS/build.log" >&2
+    return 1
+  }
+}
+
+# Makes the built package visible to rosrun, roslaunch and rostest.
+vf_source() {
+  set +u
+  # shellcheck disable=SC1091
+  source "$WS/devel/setup.bash"
+  set -u
+}

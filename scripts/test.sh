@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Installs the dependencies, builds, runs every gtest and rostest, and ends with
+# "N passed, M failed". Exits non-zero on any failure.
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+vf_install_dependencies
+werror=()
+[ -n "${CI:-}" ] && werror=(-DVF_WERROR=ON)
+vf_build "${werror[@]}"
+vf_source
+cd "$WS"
+rm -rf "$WS/build/test_results"
+status=0
+catkin_make run_tests -j1 >"$WS/tests.log" 2>&1 || status=$?
+results="$(catkin_test_results "$WS/build/test_results" 2>&1 || true)"
+echo "$results" | grep -vE '^Skipping' || true
+summary="$(echo "$results" | grep -E '^Summary:' | tail -n 1)"
+tests=$(echo "$summary" | sed -nE 's/.* ([0-9]+) tests.*/\1/p')
+errors=$(echo "$summary" | sed -nE 's/.* ([0-9]+) errors.*/\1/p')
+failures=$(echo "$summary" | sed -nE 's/.* ([0-9]+) failures.*/\1/p')
+skipped=$(echo "$summary" | sed -nE 's/.* ([0-9]+) skipped.*/\1/p')
+tests=${tests:-0}; errors=${errors:-0}; failures=${failures:-0}; skipped=${skipped:-0}
+failed=$((errors + failures))
+passed=$((tests - failed - skipped))
+if [ "$tests" -eq 0 ]; then
+  echo "no test results found; see $WS/tests.log" >&2
+  failed=$((failed + 1))
+fi
+if [ "$status" -ne 0 ] && [ "$failed" -eq 0 ]; then
+  tail -n 40 "$WS/tests.log"
+  echo "catkin_make run_tests failed; see $WS/tests.log" >&2
+  failed=1
+fi
+if [ "$skipped" -gt 0 ]; then
+  echo "$passed passed, $failed failed, $skipped skipped"
+else
+  echo "$passed passed, $failed failed"
+fi
+[ "$failed" -eq 0 ]

@@ -1,0 +1,94 @@
+#include "variational_formation/core/metrics.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace vf {
+
+Positions discreteMomentumPlus(const Formation& formation, const VariationalCoefficients& c,
+                               const Positions& qk, const Positions& qk1) {
+  Positions grad;
+  formation.gradient(qk1, grad);
+  const Positions v = (qk1 - qk) / c.timeStep;
+  return (0.5 * c.positionGain) * v - (0.5 * c.timeStep) * grad;
+}
+
+Positions discreteMomentumMinus(const Formation& formation, const VariationalCoefficients& c,
+                                const Positions& qk, const Positions& qk1) {
+  Positions grad;
+  formation.gradient(qk, grad);
+  const Positions v = (qk1 - qk) / c.timeStep;
+  // (1 + e^{kappa h}) / 2 = (2h / startGain) / 2 = h / startGain
+  return (c.timeStep / c.startGain) * v + (0.5 * c.timeStep) * grad;
+}
+
+void discreteHamiltonianFlow(const Formation& formation, const VariationalCoefficients& c,
+                             const Positions& qk, const Positions& pk, Positions& qk1,
+                             Positions& pk1) {
+  // p_k = ((1 + e^{kappa h})/2) v_k + (h/2) grad V(q_k)  =>  v_k = startGain/h (p_k - h/2 grad)
+  Positions grad;
+  formation.gradient(qk, grad);
+  qk1 = qk + c.startGain * (pk - (0.5 * c.timeStep) * grad);
+  pk1 = discreteMomentumPlus(formation, c, qk, qk1);
+}
+
+double discreteEnergy(const Formation& formation, double timeStep, const Positions& qk,
+                      const Positions& qk1) {
+  const double kinetic = 0.5 * ((qk1 - qk) / timeStep).squaredNorm();
+  return kinetic + 0.5 * (formation.potential(qk) + formation.potential(qk1));
+}
+
+Eigen::VectorXd agentDiscreteEnergy(const Formation& formation, double timeStep,
+                                    const Positions& qk, const Positions& qk1) {
+  Eigen::VectorXd e(formation.agentCount());
+  for (int i = 0; i < formation.agentCount(); ++i) {
+    const double kinetic = 0.5 * ((qk1.col(i) - qk.col(i)) / timeStep).squaredNorm();
+    e(i) = kinetic +
+           0.5 * (formation.agentPotential(i, qk) + formation.agentPotential(i, qk1));
+  }
+  return e;
+}
+
+double continuousEnergy(const Formation& formation, const Positions& q, const Positions& v) {
+  return 0.5 * v.squaredNorm() + formation.potential(q);
+}
+
+Eigen::VectorXd agentContinuousEnergy(const Formation& formation, const Positions& q,
+                                      const Positions& v) {
+  Eigen::VectorXd e(formation.agentCount());
+  for (int i = 0; i < formation.agentCount(); ++i) {
+    e(i) = 0.5 * v.col(i).squaredNorm() + formation.agentPotential(i, q);
+  }
+  return e;
+}
+
+Vector3 linearMomentum(const Positions& p) {
+  Vector3 total = Vector3::Zero();
+  for (Eigen::Index i = 0; i < p.cols(); ++i) {
+    for (Eigen::Index a = 0; a < p.rows(); ++a) total(a) += p(a, i);
+  }
+  return total;
+}
+
+Vector3 angularMomentum(const Positions& q, const Positions& p) {
+  Vector3 total = Vector3::Zero();
+  for (Eigen::Index i = 0; i < q.cols(); ++i) {
+    Vector3 qi = Vector3::Zero();
+    Vector3 pi = Vector3::Zero();
+    qi.head(q.rows()) = q.col(i);
+    pi.head(p.rows()) = p.col(i);
+    total += qi.cross(pi);
+  }
+  return total;
+}
+
+Vector3 noetherPrediction(const Vector3& initial, const VariationalCoefficients& c, long step) {
+  // (e^{-kappa h})^k underflows to 0 gracefully; e^{kappa t} is never formed.
+  return std::pow(c.decay, static_cast<double>(step)) * initial;
+}
+
+double noetherResidual(const Vector3& value, const Vector3& prediction, const Vector3& initial) {
+  return (value - prediction).norm() / std::max(initial.norm(), 1e-300);
+}
+
+}  // namespace vf

@@ -1,0 +1,206 @@
+#include "variational_formation/core/scenario.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+#include "variational_formation/core/error.hpp"
+#include "variational_formation/core/stability.hpp"
+
+namespace vf {
+
+namespace {
+
+std::string describe(const YAML::Node& node) {
+  if (!node.IsDefined() || node.IsNull()) return "nothing";
+  if (node.IsScalar()) return "'" + node.Scalar() + "'";
+  if (node.IsSequence()) return "a list";
+  return "a mapping";
+}
+
+const YAML::Node required(const YAML::Node& map, const std::string& key, const std::string& field) {
+  const YAML::Node node = map[key];
+  if (!node.IsDefined() || node.IsNull()) throw InvalidInput(field + ": missing");
+  return node;
+}
+
+double toFiniteDouble(const YAML::Node& node, const std::string& field) {
+  double value = 0.0;
+  if (!node.IsScalar() || !YAML::convert<double>::decode(node, value)) {
+    throw InvalidInput(field + ": expected a number, got " + describe(node));
+  }
+  if (!std::isfinite(value)) throw InvalidInput(field + ": must be finite, got " + node.Scalar());
+  return value;
+}
+
+long toInteger(const YAML::Node& node, const std::string& field) {
+  long value = 0;
+  if (!node.IsScalar() || !YAML::convert<long>::decode(node, value)) {
+    throw InvalidInput(field + ": expected an integer, got " + describe(node));
+  }
+  return value;
+}
+
+void rejectUnknownKeys(const YAML::Node& map, const std::set<std::string>& known,
+                       const std::string& field) {
+  for (const auto& kv : map) {
+    const std::string key = kv.first.Scalar();
+    if (!known.count(key)) {
+      std::string list;
+      for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+      throw InvalidInput((field.empty() ? key : field + "." + key) + ": unknown field (known: " +
+                         list + ")");
+    }
+  }
+}
+
+Eigen::VectorXd toVector(const YAML::Node& node, int dimension, const std::string& field) {
+  if (!node.IsSequence()) throw InvalidInput(field + ": expected a list of numbers, got " + describe(node));
+  if (static_cast<int>(node.size()) != dimension) {
+    throw InvalidInput(field + ": expected " + std::to_string(dimension) + " coordinates (dimension " +
+                       std::to_string(dimension) + "), got " + std::to_string(node.size()));
+  }
+  Eigen::VectorXd v(dimension);
+  for (int a = 0; a < dimension; ++a) {
+    v(a) = toFiniteDouble(node[a], field + "[" + std::to_string(a) + "]");
+  }
+  return v;
+}
+
+Scenario parseRoot(const YAML::Node& root) {
+  if (!root.IsMap()) throw InvalidInput("scenario: expected a YAML mapping at the top level");
+  rejectUnknownKeys(root, {"name", "dimension", "kappa", "time_step", "steps", "agents", "edges"},
+                    "");
+  Scenario s;
+  const YAML::Node name = required(root, "name", "name");
+  if (!name.IsScalar() || name.Scalar().empty()) {
+    throw InvalidInput("name: expected a non-empty string, got " + describe(name));
+  }
+  s.name = name.Scalar();
+  const long dimension = toInteger(required(root, "dimension", "dimension"), "dimension");
+  if (dimension != 2 && dimension != 3) {
+    throw InvalidInput("dimension: must be 2 or 3, got " + std::to_string(dimension));
+  }
+  s.dimension = static_cast<int>(dimension);
+  s.dampingGain = toFiniteDouble(required(root, "kappa", "kappa"), "kappa");
+  s.timeStep = toFiniteDouble(required(root, "time_step", "time_step"), "time_step");
+  s.steps = toInteger(required(root, "steps", "steps"), "steps");
+
+  const YAML::Node agents = required(root, "agents", "agents");
+  if (!agents.IsSequence() || agents.size() == 0) {
+    throw InvalidInput("agents: expected a non-empty list, got " + describe(agents));
+  }
+  const int n = static_cast<int>(agents.size());
+  s.initialPositions.resize(s.dimension, n);
+  s.initialVelocities.setZero(s.dimension, n);
+  s.desiredPositions.resize(s.dimension, n);
+  for (int i = 0; i < n; ++i) {
+    const std::string field = "agents[" + std::to_string(i) + "]";
+    const YAML::Node agent = agents[i];
+    if (!agent.IsMap()) throw InvalidInput(field + ": expected a mapping, got " + describe(agent));
+    rejectUnknownKeys(agent, {"id", "initial_position", "initial_velocity", "desired_position"},
+                      field);
+    const long id = toInteger(required(agent, "id", field + ".id"), field + ".id");
+    if (id != i) {
+      throw InvalidInput(field + ".id: ids must be 0..n-1 in order; expected " +
+                         std::to_string(i) + ", got " + std::to_string(id));
+    }
+    s.initialPositions.col(i) = toVector(required(agent, "initial_position", field + ".initial_position"),
+                                         s.dimension, field + ".initial_position");
+    if (agent["initial_velocity"].IsDefined() && !agent["initial_velocity"].IsNull()) {
+      s.initialVelocities.col(i) =
+          toVector(agent["initial_velocity"], s.dimension, field + ".initial_velocity");
+    }
+    s.desiredPositions.col(i) = toVector(required(agent, "desired_position", field + ".desired_position"),
+                                         s.dimension, field + ".desired_position");
+  }
+
+  const YAML::Node edges = root["edges"];
+  if (edges.IsDefined() && !edges.IsNull()) {
+    if (!edges.IsSequence()) throw InvalidInput("edges: expected a list of [i, j] pairs, got " + describe(edges));
+    for (std::size_t e = 0; e < edges.size(); ++e) {
+      const std::string field = "edges[" + std::to_string(e) + "]";
+      const YAML::Node pair = edges[e];
+      if (!pair.IsSequence() || pair.size() != 2) {
+        throw InvalidInput(field + ": expected a pair [i, j], got " + describe(pair));
+      }
+      const long i = toInteger(pair[0], field + "[0]");
+      const long j = toInteger(pair[1], field + "[1]");
+      const auto clamp = [](long x) {
+        return static_cast<int>(std::max<long>(std::min<long>(x, std::numeric_limits<int>::max()),
+                                               std::numeric_limits<int>::min()));
+      };
+      s.edges.emplace_back(clamp(i), clamp(j));
+    }
+  }
+  return s;
+}
+
+}  // namespace
+
+void validateScenario(Scenario& s, bool requireBoundedSteps) {
+  if (!(std::isfinite(s.dampingGain) && s.dampingGain >= 0.0)) {
+    std::ostringstream msg;
+    msg << "kappa: must be finite and >= 0, got " << s.dampingGain;
+    throw InvalidInput(msg.str());
+  }
+  if (!(std::isfinite(s.timeStep) && s.timeStep > 0.0)) {
+    std::ostringstream msg;
+    msg << "time_step: must be finite and > 0, got " << s.timeStep;
+    throw InvalidInput(msg.str());
+  }
+  if (s.steps < 0) throw InvalidInput("steps: must be >= 0, got " + std::to_string(s.steps));
+  if (requireBoundedSteps && s.steps == 0) {
+    throw InvalidInput("steps: must be >= 1 here (0 = unbounded is only for the ROS run)");
+  }
+  // Formation's constructor checks the edges and the desired shape.
+  const Formation formation = makeFormation(s);
+  s.warnings.clear();
+  if (s.agentCount() >= 2 && !formation.isInfinitesimallyRigid(s.desiredPositions)) {
+    s.warnings.push_back("edges: the desired graph is not infinitesimally rigid (rank " +
+                         std::to_string(formation.rigidityRank(s.desiredPositions)) + ", need " +
+                         std::to_string(rigidEdgeCount(s.dimension, s.agentCount())) +
+                         "): the shape is not determined by its edge lengths");
+  }
+  const StepSizeAdvice advice =
+      adviseTimeStep(formation, s.initialPositions, s.timeStep, s.dampingGain);
+  if (advice.exceeded) s.warnings.push_back(advice.message);
+}
+
+Scenario parseScenario(const std::string& yamlText, const std::string& source) {
+  try {
+    Scenario s = parseRoot(YAML::Load(yamlText));
+    validateScenario(s);
+    return s;
+  } catch (const YAML::Exception& e) {
+    std::ostringstream msg;
+    msg << source << ": YAML error at line " << e.mark.line + 1 << ", column " << e.mark.column + 1
+        << ": " << e.msg;
+    throw InvalidInput(msg.str());
+  } catch (const InvalidInput& e) {
+    throw InvalidInput(source + ": " + e.what());
+  }
+}
+
+Scenario loadScenario(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InvalidInput(path + ": cannot open the scenario file");
+  std::stringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw InvalidInput(path + ": cannot read the scenario file");
+  return parseScenario(text.str(), path);
+}
+
+Formation makeFormation(const Scenario& s) {
+  if (s.initialPositions.cols() != s.desiredPositions.cols() ||
+      s.initialVelocities.cols() != s.desiredPositions.cols()) {
+    throw InvalidInput("agents: initial and desired positions differ in count");
+  }
+  return Formation(s.dimension, s.desiredPositions, s.edges);
+}
+
+}  // namespace vf

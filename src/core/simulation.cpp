@@ -1,0 +1,83 @@
+#include "variational_formation/core/simulation.hpp"
+
+#include <cstdio>
+#include <ostream>
+
+#include "variational_formation/core/error.hpp"
+#include "variational_formation/core/metrics.hpp"
+
+namespace vf {
+
+StepMetrics measure(const Integrator& integrator) {
+  StepMetrics m;
+  m.step = integrator.stepIndex();
+  m.time = integrator.time();
+  m.energy = integrator.energy();
+  m.maxDistanceError = integrator.formation().maxDistanceError(integrator.positions());
+  const Positions p = integrator.momenta();
+  m.linearMomentum = linearMomentum(p);
+  m.angularMomentum = angularMomentum(integrator.positions(), p);
+  return m;
+}
+
+void runScenario(const Scenario& scenario, Method method, StartMethod start,
+                 const std::function<void(const Integrator&)>& observe) {
+  if (scenario.steps <= 0) {
+    throw InvalidInput("steps: must be >= 1 for a centralised run (0 = unbounded is only for the ROS run)");
+  }
+  const Formation formation = makeFormation(scenario);
+  auto integrator = makeIntegrator(method, formation, scenario.initialPositions,
+                                   scenario.initialVelocities, scenario.timeStep,
+                                   scenario.dampingGain, start);
+  observe(*integrator);
+  for (long k = 0; k < scenario.steps; ++k) {
+    integrator->step();
+    observe(*integrator);
+  }
+}
+
+namespace {
+void put(std::ostream& out, double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", x);
+  out << buf;
+}
+}  // namespace
+
+void writeTrajectoryHeader(std::ostream& out) { out << "step,t,agent,x,y,z\n"; }
+
+void writeTrajectoryRows(std::ostream& out, long step, double time, const Positions& q) {
+  for (Eigen::Index i = 0; i < q.cols(); ++i) {
+    out << step << ',';
+    put(out, time);
+    out << ',' << i;
+    for (Eigen::Index a = 0; a < 3; ++a) {
+      out << ',';
+      put(out, a < q.rows() ? q(a, i) : 0.0);
+    }
+    out << '\n';
+  }
+}
+
+void writeMetricsHeader(std::ostream& out) {
+  out << "step,t,energy,max_distance_error,px,py,pz,ax,ay,az\n";
+}
+
+void writeMetricsRow(std::ostream& out, const StepMetrics& m) {
+  out << m.step;
+  for (double x : {m.time, m.energy, m.maxDistanceError}) {
+    out << ',';
+    put(out, x);
+  }
+  for (int a = 0; a < 3; ++a) {
+    out << ',';
+    put(out, m.linearMomentum(a));
+  }
+  for (int a = 0; a < 3; ++a) {
+    out << ',';
+    put(out, m.angularMomentum(a));
+  }
+  out << '\n';
+}
+
+}  // namespace vf
