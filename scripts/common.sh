@@ -3,7 +3,7 @@
 # Source it; it defines REPO, WS and the functions below.
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-WS="$REPO/.ws"
+WS="${VF_WS:-$REPO/.ws}"
 # Debian's ROS lives in /usr; a pyenv python3 earlier on PATH has no ROS modules.
 export PATH="/usr/bin:/bin:/usr/sbin:/sbin:$PATH"
 export ROS_HOME="${ROS_HOME:-$HOME/.ros}"
