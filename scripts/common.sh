@@ -32,8 +32,16 @@ vf_install_dependencies() {
 }
 
 vf_build() {
-  mkdir -p "$WS/src"
-  ln -sfn "$REPO" "$WS/src/variational_formation"
+  # The package in the workspace is a folder of links to the repository's entries, not one
+  # link to the repository: the workspace lives inside it, and rosrun's `find -L` would loop.
+  local pkg="$WS/src/variational_formation" entry
+  [ -L "$pkg" ] && rm "$pkg"
+  mkdir -p "$pkg"
+  find "$pkg" -maxdepth 1 -type l -delete
+  for entry in "$REPO"/*; do
+    case "$(basename "$entry")" in output|build|devel) continue ;; esac
+    ln -sfn "$entry" "$pkg/$(basename "$entry")"
+  done
   local jobs
   jobs="$(nproc 2>/dev/null || echo 2)"
   (cd "$WS" && catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 \
