@@ -7,6 +7,9 @@ WS="${VF_WS:-$REPO/.ws}"
 # Debian's ROS lives in /usr; a pyenv python3 earlier on PATH has no ROS modules.
 export PATH="/usr/bin:/bin:/usr/sbin:/sbin:$PATH"
 export ROS_HOME="${ROS_HOME:-$HOME/.ros}"
+# Nothing but apt installs and ~/.ros is written outside the repository.
+export MPLCONFIGDIR="$WS/matplotlib"
+export PYTHONDONTWRITEBYTECODE=1
 
 VF_APT_PACKAGES=(
   build-essential cmake catkin ros-core-dev ros-base-dev libroscpp-dev libtf2-ros-dev
