@@ -123,30 +123,27 @@ TEST(SimulateCli, BadFlagsAreOneLineErrorsWithStatusTwo) {
   expectBadInput({"--scenario", sc, "--out", out, "--steps", "3", "--steps", "4"}, "--steps: given more than once");
 }
 
+// Writes config/square.yaml with `from` replaced by `to` and returns its path.
+std::string modifiedSquare(const std::string& name, const std::string& from, const std::string& to) {
+  std::ifstream in(kConfig + "square.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string s = text.str();
+  s.replace(s.find(from), from.size(), to);
+  const std::string path = tempPath(name);
+  std::ofstream(path) << s;
+  return path;
+}
+
 TEST(SimulateCli, BadScenarioNamesTheField) {
-  const std::string path = tempPath("bad.yaml");
-  {
-    std::ifstream in(kConfig + "square.yaml");
-    std::stringstream text;
-    text << in.rdbuf();
-    std::string s = text.str();
-    s.replace(s.find("[0, 2]"), 6, "[0, 9]");
-    std::ofstream(path) << s;
-  }
-  expectBadInput({"--scenario", path, "--out", tempPath("x.csv")}, "edges[4]: agent 9 does not exist");
+  expectBadInput({"--scenario", modifiedSquare("bad.yaml", "[0, 2]", "[0, 9]"), "--out", tempPath("x.csv")},
+                 "edges[4]: agent 9 does not exist");
 }
 
 TEST(SimulateCli, UnboundedScenarioIsRejected) {
-  const std::string path = tempPath("unbounded.yaml");
-  {
-    std::ifstream in(kConfig + "square.yaml");
-    std::stringstream text;
-    text << in.rdbuf();
-    std::string s = text.str();
-    s.replace(s.find("steps: 1200"), 11, "steps: 0");
-    std::ofstream(path) << s;
-  }
-  expectBadInput({"--scenario", path, "--out", tempPath("x.csv")}, "steps: must be >= 1");
+  expectBadInput({"--scenario", modifiedSquare("unbounded.yaml", "steps: 1200", "steps: 0"), "--out",
+                  tempPath("x.csv")},
+                 "steps: must be >= 1");
 }
 
 TEST(Arguments, IntegerRangeAndValues) {
