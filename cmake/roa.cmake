@@ -1,0 +1,25 @@
+# Region-of-attraction campaigns: core engine (ROS-free), the `roa` CLI, tests, benchmark.
+target_sources(variational_formation_core PRIVATE src/core/roa.cpp)
+find_package(Threads REQUIRED)
+target_link_libraries(variational_formation_core PUBLIC Threads::Threads)
+
+target_sources(variational_formation_tools PRIVATE src/tools/roa_cli.cpp)
+add_executable(roa src/tools/roa_main.cpp)
+target_link_libraries(roa variational_formation_tools)
+target_compile_options(roa PRIVATE ${VF_FLAGS})
+install(TARGETS roa RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+
+if(CATKIN_ENABLE_TESTING)
+  catkin_add_gtest(test_roa test/roa/test_roa.cpp)
+  target_link_libraries(test_roa variational_formation_tools gtest_main)
+  target_compile_options(test_roa PRIVATE ${VF_FLAGS})
+  target_compile_definitions(test_roa PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+endif()
+
+find_package(benchmark QUIET)
+if(benchmark_FOUND)
+  add_executable(benchmark_roa benchmark/benchmark_roa.cpp)
+  target_link_libraries(benchmark_roa variational_formation_core benchmark::benchmark)
+  target_compile_options(benchmark_roa PRIVATE ${VF_FLAGS})
+  target_compile_definitions(benchmark_roa PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+endif()
