@@ -10,6 +10,8 @@ add_library(variational_formation_core
   src/core/stability.cpp
   src/core/scenario.cpp
   src/core/simulation.cpp
+  src/core/lockstep_agent.cpp
+  src/core/monitor.cpp
 )
 target_include_directories(variational_formation_core PUBLIC
   $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/include>)

@@ -14,3 +14,8 @@ install(TARGETS simulate variational_formation_tools
   RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION}
   ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
+
+add_executable(scenario_info src/tools/scenario_info_main.cpp)
+target_link_libraries(scenario_info variational_formation_tools)
+target_compile_options(scenario_info PRIVATE ${VF_FLAGS})
+install(TARGETS scenario_info RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

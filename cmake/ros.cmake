@@ -1,0 +1,28 @@
+# The ROS layer: thin nodes over the core, plus rostests.
+add_library(variational_formation_ros src/ros/agent_node.cpp src/ros/monitor_node.cpp src/ros/markers.cpp)
+target_include_directories(variational_formation_ros SYSTEM PUBLIC ${catkin_INCLUDE_DIRS})
+target_link_libraries(variational_formation_ros variational_formation_core ${catkin_LIBRARIES})
+target_compile_options(variational_formation_ros PRIVATE ${VF_FLAGS})
+add_dependencies(variational_formation_ros ${PROJECT_NAME}_generate_messages_cpp ${catkin_EXPORTED_TARGETS})
+
+foreach(node agent monitor)
+  add_executable(${node} src/ros/${node}_main.cpp)
+  target_link_libraries(${node} variational_formation_ros)
+  target_compile_options(${node} PRIVATE ${VF_FLAGS})
+  install(TARGETS ${node} RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+endforeach()
+install(TARGETS variational_formation_ros
+  ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
+
+if(CATKIN_ENABLE_TESTING)
+  find_package(rostest REQUIRED)
+  catkin_add_gtest(test_lockstep test/core/test_lockstep.cpp)
+  target_link_libraries(test_lockstep variational_formation_core gtest_main)
+  target_compile_options(test_lockstep PRIVATE ${VF_FLAGS})
+  target_compile_definitions(test_lockstep PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  file(GLOB VF_ROSTESTS ${PROJECT_SOURCE_DIR}/test/ros/*.test)
+  foreach(t ${VF_ROSTESTS})
+    add_rostest(${t})
+  endforeach()
+endif()

@@ -1,0 +1,73 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "variational_formation/core/scenario.hpp"
+#include "variational_formation/core/variational_update.hpp"
+
+namespace vf {
+
+/**
+ * One agent of the distributed lockstep run (DESIGN.md §3), without any transport: it holds
+ * q_{k-1}, q_k of its own and the latest state of each neighbour, and computes q_{k+1} once
+ * it holds every neighbour's q_k. It calls Formation::agentGradient and variationalUpdate /
+ * variationalStart exactly as VariationalIntegrator does, so the distributed trajectory equals
+ * the centralised one bit for bit.
+ *
+ * Neighbour states arrive as (step m, q_m, q_{m-1}). A neighbour is never more than one step
+ * ahead (it needs our q_m to get past m), so a state at m = k + 1 still carries the q_k we need:
+ * a lost or late message is made good by the next one.
+ */
+class LockstepAgent {
+ public:
+  /// What became of a received neighbour state.
+  enum class Receipt { Accepted, Duplicate, UnknownSender, WrongDimension, NonFinite, ImpossibleStep };
+
+  /// @throws InvalidInput if id is not an agent of the (validated) scenario.
+  LockstepAgent(const Scenario& scenario, int id, StartMethod start = StartMethod::Variational);
+
+  /// Offers neighbour `sender`'s state at step m (q_m, q_{m-1}); never changes the agent's own
+  /// state, and keeps nothing unless the state is Accepted.
+  Receipt receive(long sender, long step, const std::vector<double>& position,
+                  const std::vector<double>& previousPosition);
+  /// Every neighbour's q_k is known.
+  bool ready() const;
+  /// q_k -> q_{k+1}. Requires ready().
+  void advance();
+
+  int id() const { return id_; }
+  long step() const { return step_; }
+  double time() const { return static_cast<double>(step_) * coefficients_.timeStep; }
+  /// scenario steps reached (never for steps = 0, unbounded).
+  bool finished() const { return scenario_.steps > 0 && step_ >= scenario_.steps; }
+  const std::vector<double>& position() const { return q_; }
+  const std::vector<double>& previousPosition() const { return qPrev_; }
+  const std::vector<int>& neighbourIds() const { return neighbourIds_; }
+  const Scenario& scenario() const { return scenario_; }
+
+  static std::string describe(Receipt receipt);
+
+ private:
+  struct NeighbourState {
+    long step = -1;
+    std::vector<double> position;
+    std::vector<double> previousPosition;
+  };
+  /// Neighbour's q_k if held, else nullptr.
+  const double* neighbourPositionAtStep(const NeighbourState& s) const;
+
+  Scenario scenario_;
+  Formation formation_;
+  VariationalCoefficients coefficients_;
+  StartMethod start_;
+  int id_;
+  int dimension_;
+  long step_ = 0;
+  std::vector<double> qPrev_, q_, v0_;
+  std::vector<int> neighbourIds_;
+  std::vector<NeighbourState> neighbours_;  // indexed by agent id (only neighbours used)
+  Positions view_;                          // q_k of self and neighbours, d x n
+};
+
+}  // namespace vf

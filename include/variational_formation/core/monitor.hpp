@@ -1,0 +1,63 @@
+#pragma once
+
+#include <map>
+#include <vector>
+
+#include "variational_formation/core/scenario.hpp"
+#include "variational_formation/core/simulation.hpp"
+#include "variational_formation/core/variational_update.hpp"
+
+namespace vf {
+
+/// Everything the monitor publishes for a completed step.
+struct FormationSnapshot {
+  StepMetrics metrics;                 ///< energy, max distance error, momenta
+  Vector3 linearMomentumPredicted;     ///< e^{-kappa t_k} P_0
+  Vector3 angularMomentumPredicted;    ///< e^{-kappa t_k} A_0
+  Eigen::VectorXd agentEnergy;
+  Eigen::VectorXd edgeDistanceErrors;
+  Positions positions;                 ///< q_k, d x n
+  bool converged = false;              ///< congruent at this step
+  long convergedStep = -1;             ///< first step of the current congruent stretch
+};
+
+/**
+ * The monitor's core: collects agents' states (q_k, q_{k-1}) by step and, for each step that
+ * every agent has reported, computes the metrics exactly as VariationalIntegrator::momenta()
+ * and energy() define them (p+_k and E_d(q_{k-1}, q_k); v_0 and the continuous energy at
+ * k = 0), so they match `simulate --metrics`.
+ */
+class FormationMonitor {
+ public:
+  explicit FormationMonitor(const Scenario& scenario, double tolerance = 0.01, double maxSpeed = 0.1);
+
+  /// Stores agent `id`'s state at `step`. @return false (and stores nothing) if the id, sizes,
+  /// values or step are invalid, or the step was already completed.
+  bool add(long id, long step, const std::vector<double>& position,
+           const std::vector<double>& previousPosition);
+  /// Completed steps in order, each removed from the buffer once returned.
+  std::vector<FormationSnapshot> takeCompleted();
+
+  long nextStep() const { return next_; }
+  const Formation& formation() const { return formation_; }
+  const Scenario& scenario() const { return scenario_; }
+
+ private:
+  FormationSnapshot measureStep(long step, const Positions& qPrev, const Positions& q);
+
+  struct Pending {
+    Positions q, qPrev;
+    std::vector<bool> seen;
+    int count = 0;
+  };
+  Scenario scenario_;
+  Formation formation_;
+  VariationalCoefficients coefficients_;
+  double tolerance_, maxSpeed_;
+  std::map<long, Pending> pending_;
+  long next_ = 0;
+  long congruentSince_ = -1;
+  Vector3 p0_, a0_;
+};
+
+}  // namespace vf

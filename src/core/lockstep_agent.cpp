@@ -1,0 +1,102 @@
+#include "variational_formation/core/lockstep_agent.hpp"
+
+#include <cmath>
+
+#include "variational_formation/core/error.hpp"
+
+namespace vf {
+
+LockstepAgent::LockstepAgent(const Scenario& scenario, int id, StartMethod start)
+    : scenario_(scenario),
+      formation_(makeFormation(scenario)),
+      coefficients_(scenario.timeStep, scenario.dampingGain),
+      start_(start),
+      id_(id),
+      dimension_(scenario.dimension) {
+  const int n = formation_.agentCount();
+  if (id < 0 || id >= n) {
+    throw InvalidInput("id: must be an agent id 0.." + std::to_string(n - 1) + ", got " +
+                       std::to_string(id));
+  }
+  q_.assign(scenario.initialPositions.col(id).data(),
+            scenario.initialPositions.col(id).data() + dimension_);
+  qPrev_ = q_;
+  v0_.assign(scenario.initialVelocities.col(id).data(),
+             scenario.initialVelocities.col(id).data() + dimension_);
+  for (const Neighbour& nb : formation_.neighbours(id)) neighbourIds_.push_back(nb.agent);
+  neighbours_.resize(static_cast<std::size_t>(n));
+  view_ = Positions::Zero(dimension_, n);
+}
+
+std::string LockstepAgent::describe(Receipt receipt) {
+  switch (receipt) {
+    case Receipt::Accepted: return "accepted";
+    case Receipt::Duplicate: return "duplicate";
+    case Receipt::UnknownSender: return "unknown sender";
+    case Receipt::WrongDimension: return "wrong dimension";
+    case Receipt::NonFinite: return "non-finite value";
+    case Receipt::ImpossibleStep: return "a step that cannot come next";
+  }
+  return "?";
+}
+
+LockstepAgent::Receipt LockstepAgent::receive(long sender, long step,
+                                              const std::vector<double>& position,
+                                              const std::vector<double>& previousPosition) {
+  bool isNeighbour = false;
+  for (int j : neighbourIds_) isNeighbour = isNeighbour || j == sender;
+  if (!isNeighbour) return Receipt::UnknownSender;
+  if (static_cast<int>(position.size()) != dimension_ ||
+      static_cast<int>(previousPosition.size()) != dimension_) {
+    return Receipt::WrongDimension;
+  }
+  for (int a = 0; a < dimension_; ++a) {
+    if (!std::isfinite(position[a]) || !std::isfinite(previousPosition[a])) return Receipt::NonFinite;
+  }
+  NeighbourState& held = neighbours_[static_cast<std::size_t>(sender)];
+  if (step == held.step) return Receipt::Duplicate;
+  // A neighbour is at most one step ahead, and never goes back.
+  if (step < 0 || step < held.step || step > step_ + 1) return Receipt::ImpossibleStep;
+  held.step = step;
+  held.position = position;
+  held.previousPosition = previousPosition;
+  return Receipt::Accepted;
+}
+
+const double* LockstepAgent::neighbourPositionAtStep(const NeighbourState& s) const {
+  if (s.step == step_) return s.position.data();
+  if (s.step == step_ + 1) return s.previousPosition.data();
+  return nullptr;
+}
+
+bool LockstepAgent::ready() const {
+  for (int j : neighbourIds_) {
+    if (!neighbourPositionAtStep(neighbours_[static_cast<std::size_t>(j)])) return false;
+  }
+  return true;
+}
+
+void LockstepAgent::advance() {
+  if (!ready()) throw InvalidInput("advance: a neighbour's state at step " + std::to_string(step_) + " is missing");
+  for (int a = 0; a < dimension_; ++a) view_(a, id_) = q_[a];
+  for (int j : neighbourIds_) {
+    const double* qj = neighbourPositionAtStep(neighbours_[static_cast<std::size_t>(j)]);
+    for (int a = 0; a < dimension_; ++a) view_(a, j) = qj[a];
+  }
+  double gradient[3];
+  formation_.agentGradient(id_, view_, gradient);
+  std::vector<double> next(static_cast<std::size_t>(dimension_));
+  if (step_ > 0) {
+    // DESIGN.md §1 explicit update, as in VariationalIntegrator::step.
+    variationalUpdate(coefficients_, dimension_, qPrev_.data(), q_.data(), gradient, next.data());
+  } else if (start_ == StartMethod::Variational) {
+    variationalStart(coefficients_, dimension_, q_.data(), v0_.data(), gradient, next.data());
+  } else {
+    paperStart(coefficients_, dimension_, q_.data(), v0_.data(), next.data());
+  }
+  qPrev_.swap(q_);
+  q_.swap(next);
+  ++step_;
+}
+
+}  // namespace vf

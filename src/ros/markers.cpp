@@ -1,0 +1,158 @@
+#include "variational_formation/ros/markers.hpp"
+
+#include <algorithm>
+#include <cstdio>
+
+namespace vf {
+
+namespace {
+
+std_msgs::ColorRGBA rgba(double r, double g, double b, double a) {
+  std_msgs::ColorRGBA c;
+  c.r = static_cast<float>(r);
+  c.g = static_cast<float>(g);
+  c.b = static_cast<float>(b);
+  c.a = static_cast<float>(a);
+  return c;
+}
+
+geometry_msgs::Point point(const Eigen::Vector3d& p) {
+  geometry_msgs::Point q;
+  q.x = p.x();
+  q.y = p.y();
+  q.z = p.z();
+  return q;
+}
+
+Eigen::Vector3d column3(const Positions& q, int i) {
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  p.head(q.rows()) = q.col(i);
+  return p;
+}
+
+visualization_msgs::Marker base(const std::string& ns, int id, int type, const ros::Time& stamp) {
+  visualization_msgs::Marker m;
+  m.header.frame_id = "world";
+  m.header.stamp = stamp;
+  m.ns = ns;
+  m.id = id;
+  m.type = type;
+  m.action = visualization_msgs::Marker::ADD;
+  m.pose.orientation.w = 1.0;
+  m.scale.x = m.scale.y = m.scale.z = 1.0;
+  return m;
+}
+
+geometry_msgs::Vector3 vector3(const Vector3& v) {
+  geometry_msgs::Vector3 m;
+  m.x = v.x();
+  m.y = v.y();
+  m.z = v.z();
+  return m;
+}
+
+}  // namespace
+
+std_msgs::ColorRGBA agentColour(int agent) {
+  static const double palette[8][3] = {{0.90, 0.10, 0.10}, {0.10, 0.45, 0.90}, {0.10, 0.75, 0.20},
+                                       {0.95, 0.60, 0.05}, {0.60, 0.20, 0.80}, {0.05, 0.80, 0.80},
+                                       {0.90, 0.30, 0.65}, {0.55, 0.40, 0.20}};
+  const auto& c = palette[agent % 8];
+  return rgba(c[0], c[1], c[2], 1.0);
+}
+
+FormationStatus toStatusMessage(const FormationSnapshot& s) {
+  FormationStatus msg;
+  msg.header.stamp = ros::Time::now();
+  msg.header.frame_id = "world";
+  msg.step = s.metrics.step;
+  msg.time = s.metrics.time;
+  msg.energy = s.metrics.energy;
+  msg.agent_energy.assign(s.agentEnergy.data(), s.agentEnergy.data() + s.agentEnergy.size());
+  msg.edge_distance_error.assign(s.edgeDistanceErrors.data(),
+                                 s.edgeDistanceErrors.data() + s.edgeDistanceErrors.size());
+  msg.max_distance_error = s.metrics.maxDistanceError;
+  msg.linear_momentum = vector3(s.metrics.linearMomentum);
+  msg.linear_momentum_predicted = vector3(s.linearMomentumPredicted);
+  msg.angular_momentum = vector3(s.metrics.angularMomentum);
+  msg.angular_momentum_predicted = vector3(s.angularMomentumPredicted);
+  msg.converged = s.converged;
+  msg.converged_step = s.convergedStep;
+  return msg;
+}
+
+visualization_msgs::MarkerArray makeMarkers(const FormationSnapshot& s, const Formation& formation,
+                                            const std::vector<std::deque<Eigen::Vector3d>>& trails) {
+  using visualization_msgs::Marker;
+  visualization_msgs::MarkerArray out;
+  const ros::Time stamp = ros::Time::now();
+  const int n = formation.agentCount();
+  // Size markers to the formation: a tenth of the shortest desired edge (or of the extent).
+  double scale = 1.0;
+  for (const Edge& e : formation.edges()) scale = std::min(scale, e.desiredDistance);
+  const double radius = std::max(0.05, 0.2 * scale);
+
+  for (int i = 0; i < n; ++i) {
+    Marker m = base("agents", i, Marker::SPHERE, stamp);
+    m.pose.position = point(column3(s.positions, i));
+    m.scale.x = m.scale.y = m.scale.z = 2.0 * radius;
+    m.color = agentColour(i);
+    out.markers.push_back(m);
+
+    Marker trail = base("trails", i, Marker::LINE_STRIP, stamp);
+    trail.scale.x = 0.25 * radius;
+    trail.color = agentColour(i);
+    trail.color.a = 0.6f;
+    for (const auto& p : trails[static_cast<std::size_t>(i)]) trail.points.push_back(point(p));
+    if (trail.points.size() < 2) trail.points.assign(2, point(column3(s.positions, i)));
+    out.markers.push_back(trail);
+  }
+
+  Marker edges = base("edges", 0, Marker::LINE_LIST, stamp);
+  edges.scale.x = 0.3 * radius;
+  edges.color = rgba(0.2, 0.8, 0.2, 1.0);
+  Marker ghost = base("desired_shape", 0, Marker::LINE_LIST, stamp);
+  ghost.scale.x = 0.2 * radius;
+  ghost.color = rgba(0.7, 0.7, 0.7, 0.35);
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero(), desiredCentroid = Eigen::Vector3d::Zero();
+  for (int i = 0; i < n; ++i) {
+    centroid += column3(s.positions, i) / n;
+    desiredCentroid += column3(formation.desiredShape(), i) / n;
+  }
+  for (std::size_t e = 0; e < formation.edges().size(); ++e) {
+    const Edge& edge = formation.edges()[e];
+    const double badness = std::min(1.0, std::abs(s.edgeDistanceErrors(static_cast<long>(e))) /
+                                             (0.1 * std::max(edge.desiredDistance, 1e-9)));
+    const std_msgs::ColorRGBA c = rgba(badness, 1.0 - 0.8 * badness, 0.1, 1.0);
+    for (int end : {edge.tail, edge.head}) {
+      edges.points.push_back(point(column3(s.positions, end)));
+      edges.colors.push_back(c);
+      ghost.points.push_back(point(column3(formation.desiredShape(), end) - desiredCentroid + centroid));
+    }
+  }
+  if (!edges.points.empty()) {
+    out.markers.push_back(edges);
+    out.markers.push_back(ghost);
+  }
+  Marker ghostAgents = base("desired_shape", 1, Marker::SPHERE_LIST, stamp);
+  ghostAgents.scale.x = ghostAgents.scale.y = ghostAgents.scale.z = 1.2 * radius;
+  ghostAgents.color = rgba(0.7, 0.7, 0.7, 0.25);
+  for (int i = 0; i < n; ++i) {
+    ghostAgents.points.push_back(point(column3(formation.desiredShape(), i) - desiredCentroid + centroid));
+  }
+  out.markers.push_back(ghostAgents);
+
+  Marker text = base("text", 0, Marker::TEXT_VIEW_FACING, stamp);
+  text.pose.position = point(centroid + Eigen::Vector3d(0, 0, 4.0 * radius));
+  text.scale.z = 1.5 * radius;
+  text.color = rgba(1.0, 1.0, 1.0, 1.0);
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "step %ld  t %.3f s\nE %.3e  error %.3e m%s", s.metrics.step,
+                s.metrics.time, s.metrics.energy, s.metrics.maxDistanceError,
+                s.converged ? "  converged" : "");
+  text.text = buf;
+  out.markers.push_back(text);
+  return out;
+}
+
+}  // namespace vf

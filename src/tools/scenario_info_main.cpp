@@ -1,0 +1,21 @@
+// `scenario_info --scenario FILE`: validates a scenario through the one loader and prints
+// "agents N" (and its warnings on stderr). Used by the launch files; exit 2 on bad input.
+#include <iostream>
+
+#include "variational_formation/core/error.hpp"
+#include "variational_formation/core/scenario.hpp"
+#include "variational_formation/tools/arguments.hpp"
+#include "variational_formation/tools/simulate_cli.hpp"
+
+int main(int argc, char** argv) {
+  try {
+    const vf::Arguments args(argc, argv, {{"--scenario", 1}});
+    const vf::Scenario s = vf::loadScenario(args.text("--scenario"));
+    for (const auto& w : s.warnings) std::cerr << "scenario_info: warning: " << w << '\n';
+    std::cout << "agents " << s.agentCount() << '\n';
+    return vf::kExitOk;
+  } catch (const vf::InvalidInput& e) {
+    std::cerr << "scenario_info: error: " << e.what() << '\n';
+    return vf::kExitBadInput;
+  }
+}
