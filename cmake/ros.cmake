@@ -1,11 +1,12 @@
 # The ROS layer: thin nodes over the core, plus rostests.
-add_library(variational_formation_ros src/ros/agent_node.cpp src/ros/monitor_node.cpp src/ros/markers.cpp)
+add_library(variational_formation_ros src/ros/agent_node.cpp src/ros/monitor_node.cpp src/ros/markers.cpp
+  src/ros/recorder_node.cpp)
 target_include_directories(variational_formation_ros SYSTEM PUBLIC ${catkin_INCLUDE_DIRS})
 target_link_libraries(variational_formation_ros variational_formation_core ${catkin_LIBRARIES})
 target_compile_options(variational_formation_ros PRIVATE ${VF_FLAGS})
 add_dependencies(variational_formation_ros ${PROJECT_NAME}_generate_messages_cpp ${catkin_EXPORTED_TARGETS})
 
-foreach(node agent monitor)
+foreach(node agent monitor recorder)
   add_executable(${node} src/ros/${node}_main.cpp)
   target_link_libraries(${node} variational_formation_ros)
   target_compile_options(${node} PRIVATE ${VF_FLAGS})
