@@ -10,7 +10,8 @@ vf_source
 cd "$WS"
 rm -rf "$WS/build/test_results"
 status=0
-catkin_make run_tests -j1 >"$WS/tests.log" 2>&1 || status=$?
+# Build the tests on every core, then run them one at a time (rostests share the machine).
+catkin_make tests -j"$(nproc)" >"$WS/tests.log" 2>&1 && catkin_make run_tests -j1 >>"$WS/tests.log" 2>&1 || status=$?
 results="$(catkin_test_results "$WS/build/test_results" 2>&1 || true)"
 echo "$results" | grep -vE '^Skipping' || true
 summary="$(echo "$results" | grep -E '^Summary:' | tail -n 1)"

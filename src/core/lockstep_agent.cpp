@@ -54,9 +54,10 @@ LockstepAgent::Receipt LockstepAgent::receive(long sender, long step,
     if (!std::isfinite(position[a]) || !std::isfinite(previousPosition[a])) return Receipt::NonFinite;
   }
   NeighbourState& held = neighbours_[static_cast<std::size_t>(sender)];
-  if (step == held.step) return Receipt::Duplicate;
   // A neighbour is at most one step ahead, and never goes back.
-  if (step < 0 || step < held.step || step > step_ + 1) return Receipt::ImpossibleStep;
+  if (step < 0 || step > step_ + 1) return Receipt::ImpossibleStep;
+  if (step == held.step) return Receipt::Duplicate;
+  if (step < held.step) return Receipt::ImpossibleStep;
   held.step = step;
   held.position = position;
   held.previousPosition = previousPosition;

@@ -1,6 +1,7 @@
 #include "variational_formation/ros/markers.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace vf {
@@ -87,10 +88,10 @@ visualization_msgs::MarkerArray makeMarkers(const FormationSnapshot& s, const Fo
   visualization_msgs::MarkerArray out;
   const ros::Time stamp = ros::Time::now();
   const int n = formation.agentCount();
-  // Size markers to the formation: a tenth of the shortest desired edge (or of the extent).
-  double scale = 1.0;
+  // Size markers to the formation: a tenth of the shortest desired edge (1 m without edges).
+  double scale = formation.edges().empty() ? 1.0 : HUGE_VAL;
   for (const Edge& e : formation.edges()) scale = std::min(scale, e.desiredDistance);
-  const double radius = std::max(0.05, 0.2 * scale);
+  const double radius = std::max(0.05, 0.1 * scale);
 
   for (int i = 0; i < n; ++i) {
     Marker m = base("agents", i, Marker::SPHERE, stamp);

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "test_support.hpp"
+#include "variational_formation/core/error.hpp"
 #include "variational_formation/core/lockstep_agent.hpp"
 #include "variational_formation/core/monitor.hpp"
 #include "variational_formation/core/variational_integrator.hpp"
