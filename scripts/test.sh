@@ -22,6 +22,13 @@ skipped=$(echo "$summary" | sed -nE 's/.* ([0-9]+) skipped.*/\1/p')
 tests=${tests:-0}; errors=${errors:-0}; failures=${failures:-0}; skipped=${skipped:-0}
 failed=$((errors + failures))
 passed=$((tests - failed - skipped))
+# A test node that dies before reporting leaves a result file with no test in it: a failure.
+empty=$(grep -lE '<testsuite[^>]* tests="0"' -r "$WS/build/test_results" 2>/dev/null || true)
+if [ -n "$empty" ]; then
+  echo "result files without a single test (a test node died?):" >&2
+  echo "$empty" >&2
+  failed=$((failed + $(echo "$empty" | wc -l)))
+fi
 if [ "$tests" -eq 0 ]; then
   echo "no test results found; see $WS/tests.log" >&2
   failed=$((failed + 1))
