@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# The main job: installs and builds if needed, runs the tetrahedron scenario, writes CSVs and
-# plots into output/ and prints a summary.
+# The main job: installs and builds if needed, runs a scenario (default: the tetrahedron) as a
+# distributed ROS run through roslaunch, headless, recording everything rviz would show to
+# output/<scenario>.bag, then plots from the bag into output/ and prints a summary.
+# usage: ./scripts/demo.sh [scenario]      (a name in config/ or a path)
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 scenario="${1:-tetrahedron}"
 vf_install_dependencies
@@ -9,9 +11,12 @@ vf_source
 out="$REPO/output"
 mkdir -p "$out"
 cfg="$REPO/config/$scenario.yaml"
-[ -f "$cfg" ] || cfg="$scenario"
-rosrun variational_formation simulate --scenario "$cfg" \
-  --out "$out/$scenario.traj.csv" --metrics "$out/$scenario.metrics.csv"
-/usr/bin/python3 "$REPO/scripts/plot_simulation.py" --scenario "$cfg" \
-  --traj "$out/$scenario.traj.csv" --metrics "$out/$scenario.metrics.csv" \
-  --out-dir "$out" --prefix "$scenario"
+[ -f "$cfg" ] || cfg="$(cd "$(dirname "$scenario")" && pwd)/$(basename "$scenario")"
+name="$(basename "$cfg" .yaml)"
+echo "running $name: one agent node per agent, the monitor and the recorder (roslaunch, headless)"
+roslaunch variational_formation formation.launch scenario:="$cfg" record:=true output_dir:="$out" \
+  >"$out/$name.launch.log" 2>&1 || { tail -n 20 "$out/$name.launch.log"; exit 1; }
+grep -E "monitor: .*steps in|congruent with" "$out/$name.launch.log" | sed -E 's/^.*\]: //; s/\x1b\[[0-9;]*m//g'
+/usr/bin/python3 "$REPO/scripts/plot_bag.py" --bag "$out/$name.bag" --scenario "$cfg" --out-dir "$out" \
+  --prefix "$name"
+echo "bag: $out/$name.bag (replay: rosbag play $out/$name.bag with rviz -d config/formation.rviz)"
