@@ -24,7 +24,8 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   for (int j : agent_->neighbourIds()) {
     subs_.push_back(nh.subscribe("agent_" + std::to_string(j) + "/state", 1000,
                                              boost::function<void(const AgentState::ConstPtr&)>(
-                                                 [this, j](const AgentState::ConstPtr& m) { onState(j, m); })));
+                                                 [this, j](const AgentState::ConstPtr& m) { onState(j, m); }),
+                                 ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
   }
   for (const std::string& w : scenario.warnings) ROS_WARN("%s: %s", frame_.c_str(), w.c_str());
   ROS_INFO("%s: scenario '%s' (%s), %d neighbours, kappa %g, h %g, %ld steps%s, real-time factor %g",

@@ -10,7 +10,7 @@ namespace vf {
 
 MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   const std::string path = requiredParam<std::string>(pnh, "scenario");
-  pnh.param("trail_length", trailLength_, 300);
+  pnh.param("trail_length", trailLength_, 100);
   pnh.param("output_subscribers", outputSubscribers_, 0);
   if (trailLength_ < 2) throw InvalidInput("~trail_length: must be >= 2");
   if (outputSubscribers_ < 0) throw InvalidInput("~output_subscribers: must be >= 0");
@@ -22,7 +22,8 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   for (int i = 0; i < n; ++i) {
     subs_.push_back(nh.subscribe("agent_" + std::to_string(i) + "/state", 1000,
                                              boost::function<void(const AgentState::ConstPtr&)>(
-                                                 [this, i](const AgentState::ConstPtr& m) { onState(i, m); })));
+                                                 [this, i](const AgentState::ConstPtr& m) { onState(i, m); }),
+                                 ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
   }
   ROS_INFO("monitor: scenario '%s' (%s), %d agents, %zu edges, %ld steps", monitor_->scenario().name.c_str(),
            path.c_str(), n, monitor_->formation().edges().size(), monitor_->scenario().steps);

@@ -22,7 +22,8 @@ void RecorderNode::subscribe(ros::NodeHandle& nh, const std::string& topic,
                                                     } catch (const std::exception& e) {
                                                       ROS_ERROR_THROTTLE(1.0, "recorder: %s", e.what());
                                                     }
-                                                  })));
+                                                  }),
+                               ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
 }
 
 RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {

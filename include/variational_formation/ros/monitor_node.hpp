@@ -18,7 +18,7 @@ using variational_formation::FormationStatus;
 /**
  * ROS I/O of the monitor: subscribes to every agent's state, publishes /formation/status and
  * /formation/markers for each completed step, and reports convergence. Maths: FormationMonitor.
- * Private parameters: ~scenario (required), ~trail_length (default 300), ~output_subscribers
+ * Private parameters: ~scenario (required), ~trail_length (default 100), ~output_subscribers
  * (subscribers of status and markers to wait for before publishing, default 0).
  */
 class MonitorNode {
@@ -36,7 +36,7 @@ class MonitorNode {
   std::vector<ros::Subscriber> subs_;
   ros::Publisher statusPub_, markersPub_;
   std::vector<std::deque<Eigen::Vector3d>> trails_;
-  int trailLength_ = 300;
+  int trailLength_ = 100;
   int outputSubscribers_ = 0;
   long dropped_ = 0;
   long reportedConvergence_ = -2;
