@@ -21,6 +21,7 @@ bool FormationMonitor::add(long id, long step, const std::vector<double>& positi
   const int n = formation_.agentCount();
   const int d = formation_.dimension();
   if (id < 0 || id >= n || step < next_) return false;
+  if (scenario_.steps > 0 && step > scenario_.steps) return false;
   if (static_cast<int>(position.size()) != d || static_cast<int>(previousPosition.size()) != d) return false;
   for (int a = 0; a < d; ++a) {
     if (!std::isfinite(position[a]) || !std::isfinite(previousPosition[a])) return false;

@@ -94,6 +94,17 @@ TEST(Lockstep, MalformedStatesAreRejectedWithoutSideEffects) {
   EXPECT_THROW(LockstepAgent(s, 6), InvalidInput);
 }
 
+TEST(Lockstep, UnboundedScenarioNeverFinishes) {
+  Scenario s = loadScenario(test::configPath("free_particle"));
+  s.steps = 0;
+  LockstepAgent a(s, 0);  // no neighbours: always ready
+  for (int k = 0; k < 1000; ++k) {
+    ASSERT_FALSE(a.finished());
+    a.advance();
+  }
+  EXPECT_EQ(a.step(), 1000);
+}
+
 TEST(Monitor, MetricsFromAgentStatesMatchTheCentralisedIntegrator) {
   const Scenario s = loadScenario(test::configPath("tetrahedron"));
   const Formation f = makeFormation(s);
@@ -119,7 +130,9 @@ TEST(Monitor, MetricsFromAgentStatesMatchTheCentralisedIntegrator) {
     }
   }
   EXPECT_FALSE(monitor.add(0, 3, {0, 0, 0}, {0, 0, 0}));  // step already completed
-  EXPECT_FALSE(monitor.add(7, s.steps + 1, {0, 0, 0}, {0, 0, 0}));
+  EXPECT_FALSE(monitor.add(7, s.steps, {0, 0, 0}, {0, 0, 0}));          // unknown agent
+  EXPECT_FALSE(monitor.add(0, s.steps + 1, {0, 0, 0}, {0, 0, 0}));      // beyond the last step
+  EXPECT_FALSE(monitor.add(0, s.steps, {0, 0}, {0, 0}));                // wrong dimension
 }
 
 }  // namespace

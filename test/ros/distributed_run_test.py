@@ -2,8 +2,9 @@
 """rostest: watches a distributed run (launch/formation.launch) and checks it.
 
 Private parameters:
-  scenario      name in config/ (required)
-  expect        converged | planar | free_particle
+  scenario          name in config/ (required)
+  expect            converged | planar | free_particle
+  real_time_factor  if > 0, the run must take steps * h / real_time_factor of wall time
 Every run is checked for: each agent's states 0..N exactly once (no gap, no duplicate), every
 agent's every step equal to `simulate`'s bit for bit, the status of every step, and the
 Noether laws on the status messages.
@@ -45,6 +46,8 @@ class DistributedRun(unittest.TestCase):
         cls.done = threading.Event()
 
         def on_state(msg, i):
+            if msg.header.frame_id == "injected":  # inject_malformed.py's, not the agent's
+                return
             with cls.lock:
                 cls.states[i].append(msg)
 
@@ -85,6 +88,15 @@ class DistributedRun(unittest.TestCase):
             if got != expected:  # exact: %.17g round-trips a double
                 mismatches += 1
         self.assertEqual(mismatches, 0, f"{mismatches} of {len(rows)} positions differ from simulate")
+
+    def test_pacing(self):
+        # With a real-time factor r, step k is due k h / r after step 0.
+        rtf = float(rospy.get_param("~real_time_factor", 0.0))
+        if rtf > 0.0:
+            first, last = self.status[0].header.stamp, self.status[-1].header.stamp
+            due = self.steps * self.h / rtf
+            self.assertGreater((last - first).to_sec(), 0.95 * due)
+            self.assertLess((last - first).to_sec(), 1.5 * due + 1.0)
 
     def test_noether_laws_on_status(self):
         for s in self.status:
