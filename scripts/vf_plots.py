@@ -51,29 +51,25 @@ def plot_trajectories(path, title, q, dimension, desired=None, edges=()):
     plt.close(fig)
 
 
-def plot_energy(path, title, t, energy):
+def _plot_semilogy(path, title, t, y, ylabel, what):
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    positive = energy > 0
-    ax.semilogy(t[positive], energy[positive])
+    positive = y > 0
+    ax.semilogy(t[positive], y[positive])
     ax.set_xlabel("t [s]")
-    ax.set_ylabel("discrete energy E_d")
-    ax.set_title(f"{title}: energy")
+    ax.set_ylabel(ylabel)
+    ax.set_title(f"{title}: {what}")
     ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def plot_energy(path, title, t, energy):
+    _plot_semilogy(path, title, t, energy, "discrete energy E_d", "energy")
 
 
 def plot_error(path, title, t, error):
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    ax.semilogy(t, np.maximum(error, 1e-300))
-    ax.set_xlabel("t [s]")
-    ax.set_ylabel("max |distance - desired| over edges [m]")
-    ax.set_title(f"{title}: formation error")
-    ax.grid(True, which="both", alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _plot_semilogy(path, title, t, error, "max |distance - desired| over edges [m]", "formation error")
 
 
 def momentum_residuals(p, a, kappa, h):

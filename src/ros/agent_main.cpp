@@ -1,16 +1,4 @@
-#include <ros/ros.h>
-
 #include "variational_formation/ros/agent_node.hpp"
+#include "variational_formation/ros/node_main.hpp"
 
-int main(int argc, char** argv) {
-  ros::init(argc, argv, "agent");
-  ros::NodeHandle nh, pnh("~");
-  try {
-    vf::AgentNode node(nh, pnh);
-    node.run();
-  } catch (const std::exception& e) {
-    ROS_FATAL("%s: %s", ros::this_node::getName().c_str(), e.what());
-    return 2;
-  }
-  return 0;
-}
+int main(int argc, char** argv) { return vf::runNode<vf::AgentNode>(argc, argv, "agent"); }
