@@ -11,9 +11,12 @@ namespace vf {
 MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   const std::string path = requiredParam<std::string>(pnh, "scenario");
   pnh.param("trail_length", trailLength_, 100);
-  pnh.param("output_subscribers", outputSubscribers_, 0);
+  pnh.param("status_subscribers", statusSubscribers_, 0);
+  pnh.param("marker_subscribers", markerSubscribers_, 0);
   if (trailLength_ < 2) throw InvalidInput("~trail_length: must be >= 2");
-  if (outputSubscribers_ < 0) throw InvalidInput("~output_subscribers: must be >= 0");
+  if (statusSubscribers_ < 0 || markerSubscribers_ < 0) {
+    throw InvalidInput("~status_subscribers/~marker_subscribers: must be >= 0");
+  }
   monitor_ = std::make_unique<FormationMonitor>(loadScenario(path));
   const int n = monitor_->formation().agentCount();
   trails_.resize(static_cast<std::size_t>(n));
@@ -71,9 +74,9 @@ void MonitorNode::publishCompleted() {
 
 void MonitorNode::run() {
   auto* queue = ros::getGlobalCallbackQueue();
-  // Hold every step until the recorder (if any) listens, so the bag misses nothing.
-  while (ros::ok() && (statusPub_.getNumSubscribers() < static_cast<unsigned>(outputSubscribers_) ||
-                       markersPub_.getNumSubscribers() < static_cast<unsigned>(outputSubscribers_))) {
+  // Hold every step until the recorder and rviz (if any) listen, so that they miss nothing.
+  while (ros::ok() && (statusPub_.getNumSubscribers() < static_cast<unsigned>(statusSubscribers_) ||
+                       markersPub_.getNumSubscribers() < static_cast<unsigned>(markerSubscribers_))) {
     queue->callAvailable(ros::WallDuration(0.005));
   }
   const long last = monitor_->scenario().steps;

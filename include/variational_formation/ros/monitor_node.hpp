@@ -18,8 +18,8 @@ using variational_formation::FormationStatus;
 /**
  * ROS I/O of the monitor: subscribes to every agent's state, publishes /formation/status and
  * /formation/markers for each completed step, and reports convergence. Maths: FormationMonitor.
- * Private parameters: ~scenario (required), ~trail_length (default 100), ~output_subscribers
- * (subscribers of status and markers to wait for before publishing, default 0).
+ * Private parameters: ~scenario (required), ~trail_length (default 100), ~status_subscribers and
+ * ~marker_subscribers (subscribers to wait for before publishing step 0, default 0).
  */
 class MonitorNode {
  public:
@@ -37,7 +37,8 @@ class MonitorNode {
   ros::Publisher statusPub_, markersPub_;
   std::vector<std::deque<Eigen::Vector3d>> trails_;
   int trailLength_ = 100;
-  int outputSubscribers_ = 0;
+  int statusSubscribers_ = 0;
+  int markerSubscribers_ = 0;
   long dropped_ = 0;
   long reportedConvergence_ = -2;
   ros::WallTime firstStepAt_;
