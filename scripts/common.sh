@@ -7,6 +7,8 @@ WS="${VF_WS:-$REPO/.ws}"
 # Debian's ROS lives in /usr; a pyenv python3 earlier on PATH has no ROS modules.
 export PATH="/usr/bin:/bin:/usr/sbin:/sbin:$PATH"
 export ROS_HOME="${ROS_HOME:-$HOME/.ros}"
+# Local runs: name this host by loopback, whatever its hostname resolves to.
+export ROS_HOSTNAME="${ROS_HOSTNAME:-localhost}"
 # Nothing but apt installs and ~/.ros is written outside the repository.
 export MPLCONFIGDIR="$WS/matplotlib"
 export PYTHONDONTWRITEBYTECODE=1
