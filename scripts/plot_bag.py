@@ -9,15 +9,9 @@ import os
 import sys
 
 import numpy as np
-import yaml
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import vf_plots  # noqa: E402
-
-
-def fail(message):
-    print(f"plot_bag: error: {message}", file=sys.stderr)
-    sys.exit(2)
 
 
 def main():
@@ -30,15 +24,9 @@ def main():
     try:
         import rosbag
     except ImportError:
-        fail("python3-rosbag is not installed (run with /usr/bin/python3)")
-    try:
-        with open(args.scenario) as f:
-            scenario = yaml.safe_load(f)
-        n, dimension = len(scenario["agents"]), int(scenario["dimension"])
-        kappa, h = float(scenario["kappa"]), float(scenario["time_step"])
-        edges = [tuple(e) for e in scenario.get("edges") or []]
-    except (OSError, yaml.YAMLError, KeyError, TypeError, ValueError) as e:
-        fail(f"{args.scenario}: cannot read the scenario ({e})")
+        vf_plots.fail("python3-rosbag is not installed (run with /usr/bin/python3)")
+    scenario = vf_plots.read_scenario(args.scenario)
+    n, dimension, kappa, h = scenario.n, scenario.dimension, scenario.kappa, scenario.time_step
     positions, status = {}, {}
     try:
         with rosbag.Bag(args.bag) as bag:
@@ -49,13 +37,13 @@ def main():
                 else:
                     positions[(msg.step, msg.id)] = list(msg.position) + [0.0] * (3 - len(msg.position))
     except Exception as e:  # rosbag raises several unrelated types for unreadable files
-        fail(f"{args.bag}: cannot read the bag ({e})")
+        vf_plots.fail(f"{args.bag}: cannot read the bag ({e})")
     steps = sorted(status)
     if not steps or steps != list(range(len(steps))):
-        fail(f"{args.bag}: the status messages do not cover steps 0..N without gaps")
+        vf_plots.fail(f"{args.bag}: the status messages do not cover steps 0..N without gaps")
     missing = [(k, i) for k in steps for i in range(n) if (k, i) not in positions]
     if missing:
-        fail(f"{args.bag}: {len(missing)} agent states missing, first (step, agent) = {missing[0]}")
+        vf_plots.fail(f"{args.bag}: {len(missing)} agent states missing, first (step, agent) = {missing[0]}")
     q = np.array([[positions[(k, i)] for i in range(n)] for k in steps])
     t = np.array([status[k].time for k in steps])
     energy = np.array([status[k].energy for k in steps])
@@ -63,9 +51,9 @@ def main():
     p = np.array([[status[k].linear_momentum.x, status[k].linear_momentum.y, status[k].linear_momentum.z] for k in steps])
     a = np.array([[status[k].angular_momentum.x, status[k].angular_momentum.y, status[k].angular_momentum.z]
                   for k in steps])
-    prefix = args.prefix or scenario.get("name", "run")
+    prefix = args.prefix or scenario.name or "run"
     for path in vf_plots.plot_all(args.out_dir, prefix, prefix + " (distributed)", t, q, dimension,
-                                  energy, error, p, a, kappa, h, edges).values():
+                                  energy, error, p, a, kappa, h, scenario.edges).values():
         print(f"wrote {path}")
     last = status[steps[-1]]
     print(f"converged: {'yes, from step %d' % last.converged_step if last.converged else 'no'}")

@@ -6,6 +6,7 @@ Colour: time of the first converged step; grey: did not converge; black: diverge
 shape (edges and agents) is drawn on top, with the moved agent's desired position circled.
 """
 import argparse
+import os
 import sys
 
 import matplotlib
@@ -13,15 +14,12 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-import yaml  # noqa: E402
 from matplotlib.colors import ListedColormap  # noqa: E402
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import vf_plots  # noqa: E402
+
 HEADER = "ix,iy,x,y,converged,converged_step,diverged"
-
-
-def fail(message):
-    print(f"plot_roa: error: {message}", file=sys.stderr)
-    sys.exit(2)
 
 
 def main():
@@ -36,19 +34,17 @@ def main():
         with open(args.roa) as f:
             header = f.readline().strip()
         if header != HEADER:
-            fail(f"{args.roa}: expected header '{HEADER}', got '{header}'")
+            vf_plots.fail(f"{args.roa}: expected header '{HEADER}', got '{header}'")
         data = np.loadtxt(args.roa, delimiter=",", skiprows=1, ndmin=2)
-        with open(args.scenario) as f:
-            scenario = yaml.safe_load(f)
-        desired = np.array([a["desired_position"] for a in scenario["agents"]], float)
-        edges = scenario.get("edges") or []
-        h = args.time_step or float(scenario["time_step"])
-    except (OSError, ValueError, KeyError, TypeError, yaml.YAMLError) as e:
-        fail(str(e))
+    except (OSError, ValueError) as e:
+        vf_plots.fail(f"{args.roa}: cannot read the campaign ({e})")
+    scenario = vf_plots.read_scenario(args.scenario)
+    desired, edges = scenario.desired, scenario.edges
+    h = args.time_step or scenario.time_step
     if data.shape[0] == 0:
-        fail(f"{args.roa}: no cells")
+        vf_plots.fail(f"{args.roa}: no cells")
     if not 0 <= args.agent < len(desired):
-        fail(f"--agent: must be 0..{len(desired) - 1}")
+        vf_plots.fail(f"--agent: must be 0..{len(desired) - 1}")
     ix, iy = data[:, 0].astype(int), data[:, 1].astype(int)
     nx, ny = ix.max() + 1, iy.max() + 1
     time = np.full((ny, nx), np.nan)
@@ -79,7 +75,7 @@ def main():
     ax.set_xlabel("x of agent %d at start [m]" % args.agent)
     ax.set_ylabel("y of agent %d at start [m]" % args.agent)
     n = len(data)
-    ax.set_title(f"{scenario.get('name', '')}: region of attraction of agent {args.agent}\n"
+    ax.set_title(f"{scenario.name}: region of attraction of agent {args.agent}\n"
                  f"{n} cells: {100 * conv.mean():.1f}% converged (colour), "
                  f"{100 * (status == 1).mean():.1f}% not (grey), "
                  f"{100 * (status == 2).mean():.1f}% diverged (black)", fontsize=9)

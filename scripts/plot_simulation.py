@@ -9,15 +9,9 @@ import os
 import sys
 
 import numpy as np
-import yaml
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import vf_plots  # noqa: E402
-
-
-def fail(message):
-    print(f"plot_simulation: error: {message}", file=sys.stderr)
-    sys.exit(2)
 
 
 def load_csv(path, header):
@@ -25,10 +19,10 @@ def load_csv(path, header):
         with open(path) as f:
             first = f.readline().strip()
         if first != header:
-            fail(f"{path}: expected header '{header}', got '{first}'")
+            vf_plots.fail(f"{path}: expected header '{header}', got '{first}'")
         return np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
     except (OSError, ValueError) as e:
-        fail(f"{path}: {e}")
+        vf_plots.fail(f"{path}: {e}")
 
 
 def main():
@@ -39,24 +33,17 @@ def main():
     parser.add_argument("--out-dir", default="output")
     parser.add_argument("--prefix", default=None)
     args = parser.parse_args()
-    try:
-        with open(args.scenario) as f:
-            scenario = yaml.safe_load(f)
-        dimension = int(scenario["dimension"])
-        kappa = float(scenario["kappa"])
-        n = len(scenario["agents"])
-        edges = [tuple(e) for e in scenario.get("edges") or []]
-    except (OSError, yaml.YAMLError, KeyError, TypeError, ValueError) as e:
-        fail(f"{args.scenario}: cannot read the scenario ({e})")
+    scenario = vf_plots.read_scenario(args.scenario)
+    n, dimension, kappa, edges = scenario.n, scenario.dimension, scenario.kappa, scenario.edges
     traj = load_csv(args.traj, "step,t,agent,x,y,z")
     metrics = load_csv(args.metrics, "step,t,energy,max_distance_error,px,py,pz,ax,ay,az")
     if traj.shape[0] % n != 0 or traj.shape[0] == 0:
-        fail(f"{args.traj}: {traj.shape[0]} rows is not a multiple of {n} agents")
+        vf_plots.fail(f"{args.traj}: {traj.shape[0]} rows is not a multiple of {n} agents")
     steps = traj.shape[0] // n
     q = traj[:, 3:6].reshape(steps, n, 3)
     t = metrics[:, 1]
     h = t[1] - t[0] if len(t) > 1 else 1.0
-    prefix = args.prefix or scenario.get("name", "run")
+    prefix = args.prefix or scenario.name or "run"
     paths = vf_plots.plot_all(args.out_dir, prefix, prefix, t, q, dimension, metrics[:, 2],
                               metrics[:, 3], metrics[:, 4:7], metrics[:, 7:10], kappa, h, edges)
     for p in paths.values():
