@@ -1,6 +1,7 @@
 #include "variational_formation/core/scenario.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <set>
@@ -187,6 +188,10 @@ Scenario parseScenario(const std::string& yamlText, const std::string& source) {
 }
 
 Scenario loadScenario(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw InvalidInput(path + ": is a directory, not a scenario file");
+  }
   std::ifstream in(path);
   if (!in) throw InvalidInput(path + ": cannot open the scenario file");
   std::stringstream text;

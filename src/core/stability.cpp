@@ -17,7 +17,12 @@ double maxStiffnessFrequency(const Formation& formation, const Positions& q) {
 }
 
 bool isLinearlyStable(double timeStep, double frequency, double dampingGain) {
-  return timeStep * frequency < 2.0 * std::cosh(0.5 * dampingGain * timeStep);
+  if (!(frequency > 0.0)) return true;
+  const double x = 0.5 * dampingGain * timeStep;
+  const double lhs = timeStep * frequency, rhs = 2.0 * std::cosh(x);
+  if (std::isfinite(lhs) && std::isfinite(rhs)) return lhs < rhs;
+  // Overflow (absurd h or kappa): compare logs, log(2 cosh x) = |x| + log1p(e^{-2|x|}).
+  return std::log(timeStep) + std::log(frequency) < std::abs(x) + std::log1p(std::exp(-2.0 * std::abs(x)));
 }
 
 double stableTimeStepLimit(double frequency, double dampingGain) {

@@ -60,6 +60,14 @@ TEST(Scenario, YamlSyntaxError) { expectError(kHeader + "agents: [\n", {"YAML er
 TEST(Scenario, MissingFile) {
   EXPECT_THROW(loadScenario("/nonexistent/x.yaml"), InvalidInput);
 }
+TEST(Scenario, DirectoryIsNotAScenarioFile) {
+  try {
+    loadScenario(VF_SOURCE_DIR "/config");
+    ADD_FAILURE() << "a directory was accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
+  }
+}
 TEST(Scenario, TopLevelMustBeAMapping) { expectError("- 1\n- 2\n", {"top level"}); }
 TEST(Scenario, MissingRequiredFields) {
   for (const std::string field : {"name", "dimension", "kappa", "time_step", "steps"}) {

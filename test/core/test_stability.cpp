@@ -58,6 +58,14 @@ TEST(Stability, StrongDampingHasNoLimit) {
   EXPECT_TRUE(std::isinf(stableTimeStepLimit(0.0, 1.0)));
 }
 
+TEST(Stability, HugeStepsCompareWithoutOverflow) {
+  // 2 cosh(kappa h / 2) and h w overflow here; the damped mode is still stable, the undamped not.
+  EXPECT_TRUE(isLinearlyStable(1e308, 16.5, 13.0));
+  EXPECT_FALSE(isLinearlyStable(1e308, 1e10, 0.0));
+  EXPECT_FALSE(isLinearlyStable(1e300, 1e10, 1e-300));
+  EXPECT_TRUE(isLinearlyStable(1e3, 0.0, 0.0));  // no stiffness: nothing to destabilise
+}
+
 TEST(Stability, AdviceWarnsAboveTheLimit) {
   const Formation f = pair();
   EXPECT_FALSE(adviseTimeStep(f, f.desiredShape(), 0.5, 0.0).exceeded);
