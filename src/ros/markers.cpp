@@ -144,7 +144,10 @@ visualization_msgs::MarkerArray makeMarkers(const FormationSnapshot& s, const Fo
   out.markers.push_back(ghostAgents);
 
   Marker text = base("text", 0, Marker::TEXT_VIEW_FACING, stamp);
-  text.pose.position = point(centroid + Eigen::Vector3d(0, 0, 4.0 * radius));
+  // Beside the formation (beyond its largest y and z), not on top of its agents.
+  Eigen::Vector3d corner = column3(s.positions, 0);
+  for (int i = 1; i < n; ++i) corner = corner.cwiseMax(column3(s.positions, i));
+  text.pose.position = point(Eigen::Vector3d(centroid.x(), corner.y() + 4.0 * radius, corner.z() + 2.0 * radius));
   text.scale.z = 1.5 * radius;
   text.color = rgba(1.0, 1.0, 1.0, 1.0);
   char buf[160];
