@@ -18,10 +18,6 @@ install(TARGETS variational_formation_ros
 
 if(CATKIN_ENABLE_TESTING)
   find_package(rostest REQUIRED)
-  catkin_add_gtest(test_lockstep test/core/test_lockstep.cpp)
-  target_link_libraries(test_lockstep variational_formation_core gtest_main)
-  target_compile_options(test_lockstep PRIVATE ${VF_FLAGS})
-  target_compile_definitions(test_lockstep PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   file(GLOB VF_ROSTESTS ${PROJECT_SOURCE_DIR}/test/ros/*.test)
   foreach(t ${VF_ROSTESTS})
     add_rostest(${t})
