@@ -92,7 +92,9 @@ void AgentNode::run() {
   publish();
   auto* queue = ros::getGlobalCallbackQueue();
   while (ros::ok() && !agent_->finished()) {
-    queue->callAvailable(ros::WallDuration(0.001));
+    // Block only while a neighbour's state is missing: callAvailable returns as soon as one
+    // arrives, so a long timeout costs no latency and spares idle wake-ups (50 agents on 2 cores).
+    queue->callAvailable(agent_->ready() ? ros::WallDuration(0.0) : ros::WallDuration(0.1));
     if (!agent_->ready()) continue;
     if (realTimeFactor_ > 0.0) {
       const double due = (agent_->step() + 1) * agent_->scenario().timeStep / realTimeFactor_;
