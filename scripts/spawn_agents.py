@@ -3,10 +3,12 @@
 
 Used by launch/formation.launch, so that any scenario runs without per-scenario launch files.
 The scenario is checked by the package's one loader (scenario_info). The spawner exits with
-the first non-zero status of an agent (stopping the others), or 0 once all have finished.
+the first non-zero status of an agent (stopping the others), or 0 once all have finished; with
+--linger it stays after a successful run until it is stopped, so that (as a required node) its
+exit always means a failure, which ends the launch.
 
 usage: spawn_agents.py --scenario FILE [--rate R] [--extra-subscribers N] [--tf-subscribers N]
-                       [--order forward|reverse] [--stagger SECONDS]
+                       [--order forward|reverse] [--stagger SECONDS] [--linger]
 """
 import argparse
 import signal
@@ -28,9 +30,11 @@ def main():
     parser.add_argument("--tf-subscribers", type=int, default=0)
     parser.add_argument("--order", choices=("forward", "reverse"), default="forward")
     parser.add_argument("--stagger", type=float, default=0.0)
+    parser.add_argument("--linger", action="store_true")
+    parser.error = fail  # one line, status 2
     args, _ = parser.parse_known_args()  # roslaunch appends __name:= and __log:=
-    if args.rate < 0 or args.stagger < 0:
-        fail("--rate and --stagger must be >= 0")
+    if not args.rate >= 0 or not args.stagger >= 0:  # also rejects nan
+        fail(f"--rate and --stagger must be >= 0, got {args.rate} and {args.stagger}")
     info = subprocess.run(["rosrun", "variational_formation", "scenario_info", "--scenario", args.scenario],
                           capture_output=True, text=True)
     if info.returncode != 0:
@@ -73,6 +77,8 @@ def main():
                 status = code
                 stop()
         time.sleep(0.05)
+    while args.linger and status == 0 and not stopping:
+        signal.pause()  # until roslaunch ends the run
     sys.exit(status)
 
 

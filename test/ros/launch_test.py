@@ -4,6 +4,7 @@
 - The recorded bag holds every step of every agent, status, markers and tf, with no gap and no
   duplicate.
 - A bad scenario makes the nodes exit non-zero with a one-line error naming the field.
+- A bad launch argument ends the launch with a one-line error naming it.
 - The recorded bag, replayed into rviz under Xvfb with the shipped config, renders the agents:
   the screenshot contains the agent marker colours.
 """
@@ -90,6 +91,15 @@ class LaunchTest(unittest.TestCase):
         for line in errors:
             self.assertIn("edges[9]", line)
         self.assertIn("exit code 2", out)  # roslaunch reports the nodes' status
+
+    def test_bad_launch_argument_ends_the_launch(self):
+        # The spawner is required: its one-line error ends the launch (launch() times out if not).
+        for arg, words in (("order:=sideways", "argument --order"), ("rate:=-1", "--rate and --stagger")):
+            run = launch(f"scenario:={SCENARIO}", arg, timeout=60)
+            out = run.stdout + run.stderr
+            errors = [line for line in out.splitlines() if line.startswith("spawn_agents: error:")]
+            self.assertEqual(len(errors), 1, out[-3000:])
+            self.assertIn(words, errors[0])
 
     def test_rviz_renders_the_recorded_bag(self):
         self.assertTrue(os.path.exists(self.bag))
