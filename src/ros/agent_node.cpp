@@ -11,9 +11,9 @@ namespace vf {
 AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   const int id = requiredParam<int>(pnh, "id");
   const std::string path = requiredParam<std::string>(pnh, "scenario");
-  pnh.param("real_time_factor", realTimeFactor_, 0.0);
-  pnh.param("extra_subscribers", extraSubscribers_, 1);
-  pnh.param("tf_subscribers", tfSubscribers_, 0);
+  realTimeFactor_ = optionalParam(pnh, "real_time_factor", 0.0);
+  extraSubscribers_ = optionalParam(pnh, "extra_subscribers", 1);
+  tfSubscribers_ = optionalParam(pnh, "tf_subscribers", 0);
   if (!(realTimeFactor_ >= 0.0)) throw InvalidInput("~real_time_factor: must be >= 0 (0 = as fast as possible)");
   if (extraSubscribers_ < 0 || tfSubscribers_ < 0) throw InvalidInput("~extra_subscribers/~tf_subscribers: must be >= 0");
   const Scenario scenario = loadScenario(path);

@@ -10,9 +10,9 @@ namespace vf {
 
 MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   const std::string path = requiredParam<std::string>(pnh, "scenario");
-  pnh.param("trail_length", trailLength_, 100);
-  pnh.param("status_subscribers", statusSubscribers_, 0);
-  pnh.param("marker_subscribers", markerSubscribers_, 0);
+  trailLength_ = optionalParam(pnh, "trail_length", 100);
+  statusSubscribers_ = optionalParam(pnh, "status_subscribers", 0);
+  markerSubscribers_ = optionalParam(pnh, "marker_subscribers", 0);
   if (trailLength_ < 2) throw InvalidInput("~trail_length: must be >= 2");
   if (statusSubscribers_ < 0 || markerSubscribers_ < 0) {
     throw InvalidInput("~status_subscribers/~marker_subscribers: must be >= 0");

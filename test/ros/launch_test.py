@@ -5,6 +5,7 @@
   duplicate.
 - A bad scenario makes the nodes exit non-zero with a one-line error naming the field.
 - A bad launch argument ends the launch with a one-line error naming it.
+- A bad node parameter is one ROS_FATAL line naming it and exit status 2.
 - The recorded bag, replayed into rviz under Xvfb with the shipped config, renders the agents:
   the screenshot contains the agent marker colours.
 """
@@ -100,6 +101,22 @@ class LaunchTest(unittest.TestCase):
             errors = [line for line in out.splitlines() if line.startswith("spawn_agents: error:")]
             self.assertEqual(len(errors), 1, out[-3000:])
             self.assertIn(words, errors[0])
+
+    def test_bad_node_parameters_are_one_fatal_line(self):
+        scenario = os.path.join(self.pkg, "config", SCENARIO + ".yaml")
+        cases = (("monitor", ["_trail_length:=abc"], "~trail_length: expected an integer"),
+                 ("monitor", ["_trail_length:=1"], "~trail_length: must be >= 2"),
+                 ("agent", ["_id:=1", "_real_time_factor:=fast"], "~real_time_factor: expected a number"),
+                 ("agent", ["_id:=99"], "id: must be an agent id 0..5, got 99"),
+                 ("agent", [], "~id: required parameter missing"))
+        for k, (node, params, words) in enumerate(cases):
+            # A fresh node name each time: private parameters stay on the master after a run.
+            run = subprocess.run(["rosrun", PKG, node, f"__name:=param_probe_{k}", f"_scenario:={scenario}",
+                                  *params], capture_output=True, text=True, timeout=30)
+            fatal = [line for line in (run.stdout + run.stderr).splitlines() if "FATAL" in line]
+            self.assertEqual(run.returncode, 2, f"{node} {params}: {run.stdout[-1000:]}{run.stderr[-1000:]}")
+            self.assertEqual(len(fatal), 1, f"{node} {params}")
+            self.assertIn(words, fatal[0])
 
     def test_rviz_renders_the_recorded_bag(self):
         self.assertTrue(os.path.exists(self.bag))
