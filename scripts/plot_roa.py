@@ -30,14 +30,7 @@ def main():
     parser.add_argument("--time-step", type=float, default=None)
     parser.add_argument("--out", required=True)
     args = parser.parse_args()
-    try:
-        with open(args.roa) as f:
-            header = f.readline().strip()
-        if header != HEADER:
-            vf_plots.fail(f"{args.roa}: expected header '{HEADER}', got '{header}'")
-        data = np.loadtxt(args.roa, delimiter=",", skiprows=1, ndmin=2)
-    except (OSError, ValueError) as e:
-        vf_plots.fail(f"{args.roa}: cannot read the campaign ({e})")
+    data = vf_plots.load_csv(args.roa, HEADER)
     scenario = vf_plots.read_scenario(args.scenario)
     desired, edges = scenario.desired, scenario.edges
     h = args.time_step or scenario.time_step

@@ -14,17 +14,6 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import vf_plots  # noqa: E402
 
 
-def load_csv(path, header):
-    try:
-        with open(path) as f:
-            first = f.readline().strip()
-        if first != header:
-            vf_plots.fail(f"{path}: expected header '{header}', got '{first}'")
-        return np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
-    except (OSError, ValueError) as e:
-        vf_plots.fail(f"{path}: {e}")
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenario", required=True)
@@ -35,8 +24,8 @@ def main():
     args = parser.parse_args()
     scenario = vf_plots.read_scenario(args.scenario)
     n, dimension, kappa, edges = scenario.n, scenario.dimension, scenario.kappa, scenario.edges
-    traj = load_csv(args.traj, "step,t,agent,x,y,z")
-    metrics = load_csv(args.metrics, "step,t,energy,max_distance_error,px,py,pz,ax,ay,az")
+    traj = vf_plots.load_csv(args.traj, "step,t,agent,x,y,z")
+    metrics = vf_plots.load_csv(args.metrics, "step,t,energy,max_distance_error,px,py,pz,ax,ay,az")
     if traj.shape[0] % n != 0 or traj.shape[0] == 0:
         vf_plots.fail(f"{args.traj}: {traj.shape[0]} rows is not a multiple of {n} agents")
     steps = traj.shape[0] // n

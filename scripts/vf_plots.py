@@ -26,6 +26,18 @@ def fail(message):
     sys.exit(2)
 
 
+def load_csv(path, header):
+    """The rows of a CSV file whose first line must be `header`, as a 2D array; fail() if not."""
+    try:
+        with open(path) as f:
+            first = f.readline().strip()
+        if first != header:
+            fail(f"{path}: expected header '{header}', got '{first}'")
+        return np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    except (OSError, ValueError) as e:
+        fail(f"{path}: {e}")
+
+
 def read_scenario(path):
     """The fields of a scenario file (already checked by the package's loader) that the plots
     use: name, dimension, kappa, time_step, n, desired (n x d array) and edges."""
