@@ -1,5 +1,6 @@
 # The ROS layer: thin nodes over the core, plus rostests.
 add_library(variational_formation_ros src/ros/agent_node.cpp src/ros/monitor_node.cpp src/ros/markers.cpp
+  src/ros/participants.cpp
   src/ros/recorder_node.cpp)
 target_include_directories(variational_formation_ros SYSTEM PUBLIC ${catkin_INCLUDE_DIRS})
 target_link_libraries(variational_formation_ros variational_formation_core ${catkin_LIBRARIES})
@@ -18,8 +19,21 @@ install(TARGETS variational_formation_ros
 
 if(CATKIN_ENABLE_TESTING)
   find_package(rostest REQUIRED)
-  file(GLOB VF_ROSTESTS ${PROJECT_SOURCE_DIR}/test/ros/*.test)
-  foreach(t ${VF_ROSTESTS})
-    add_rostest(${t})
+  # One parametrised run test (test/ros/distributed_run.test), registered once per case.
+  set(VF_RUN_CASES
+    "scenario:=tetrahedron"
+    "scenario:=tetrahedron_paper expect:=planar"
+    "scenario:=hexagon"
+    "scenario:=square"
+    "scenario:=grid24"
+    "scenario:=free_particle expect:=free_particle"
+    "scenario:=hexagon order:=reverse stagger:=1"
+    "scenario:=hexagon rate:=1 inject:=true")
+  foreach(case ${VF_RUN_CASES})
+    separate_arguments(args UNIX_COMMAND "${case}")
+    add_rostest(test/ros/distributed_run.test ARGS ${args})
+  endforeach()
+  foreach(t two_formations launch)
+    add_rostest(test/ros/${t}.test)
   endforeach()
 endif()

@@ -14,8 +14,9 @@ cfg="$REPO/config/$scenario.yaml"
 [ -f "$cfg" ] || cfg="$(cd "$(dirname "$scenario")" && pwd)/$(basename "$scenario")"
 name="$(basename "$cfg" .yaml)"
 echo "running $name: one agent node per agent, the monitor and the recorder (roslaunch, headless)"
-roslaunch variational_formation formation.launch scenario:="$cfg" record:=true output_dir:="$out" \
-  >"$out/$name.launch.log" 2>&1 || { tail -n 20 "$out/$name.launch.log"; exit 1; }
+# run_formation.sh exits non-zero when the run failed (roslaunch itself exits 0 then).
+"$REPO/scripts/run_formation.sh" scenario:="$cfg" record:=true output_dir:="$out" \
+  >"$out/$name.launch.log" 2>&1 || { tail -n 20 "$out/$name.launch.log"; echo "demo: the run failed; log: $out/$name.launch.log" >&2; exit 1; }
 grep -E "monitor: .*steps in|congruent with" "$out/$name.launch.log" | sed -E 's/^.*\]: //; s/\x1b\[[0-9;]*m//g'
 /usr/bin/python3 "$REPO/scripts/plot_bag.py" --bag "$out/$name.bag" --scenario "$cfg" --out-dir "$out" \
   --prefix "$name"

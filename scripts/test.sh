@@ -24,11 +24,13 @@ failed=$((errors + failures))
 passed=$((tests - failed - skipped))
 # A test node that dies before reporting leaves a result file with no test in it: a failure.
 empty=$(grep -lE '<testsuite[^>]* tests="0"' -r "$WS/build/test_results" 2>/dev/null || true)
-for wrapper in "$WS"/build/test_results/*/rostest-test_ros_*.xml; do
-  [ -e "$wrapper" ] || continue
-  inner="$(dirname "$wrapper")/rosunit-$(basename "$wrapper" .xml | sed 's/^rostest-test_ros_//').xml"
-  [ -e "$inner" ] || empty="$empty${empty:+$'\n'}$inner (missing)"
-done
+# Each rostest writes a wrapper (rostest-*.xml) and its test node's own results (rosunit-*.xml,
+# named by the unique test-name); a node that died before reporting leaves no inner file.
+wrappers=$(find "$WS/build/test_results" -name 'rostest-*.xml' | wc -l)
+inner=$(find "$WS/build/test_results" -name 'rosunit-*.xml' | wc -l)
+if [ "$inner" -lt "$wrappers" ]; then
+  empty="$empty${empty:+$'\n'}$((wrappers - inner)) rostest(s) without their test node's results"
+fi
 if [ -n "$empty" ]; then
   echo "result files without a single test (a test node died?):" >&2
   echo "$empty" >&2

@@ -70,6 +70,11 @@ const double* LockstepAgent::neighbourPositionAtStep(const NeighbourState& s) co
   return nullptr;
 }
 
+bool LockstepAgent::holdsNeighbourStep(int j) const {
+  return j >= 0 && j < static_cast<int>(neighbours_.size()) &&
+         neighbourPositionAtStep(neighbours_[static_cast<std::size_t>(j)]) != nullptr;
+}
+
 bool LockstepAgent::ready() const {
   for (int j : neighbourIds_) {
     if (!neighbourPositionAtStep(neighbours_[static_cast<std::size_t>(j)])) return false;

@@ -16,30 +16,54 @@ FormationMonitor::FormationMonitor(const Scenario& scenario, double tolerance, d
   a0_ = angularMomentum(scenario.initialPositions, scenario.initialVelocities);
 }
 
-bool FormationMonitor::add(long id, long step, const std::vector<double>& position,
-                           const std::vector<double>& previousPosition) {
+std::string FormationMonitor::describe(Receipt receipt) {
+  switch (receipt) {
+    case Receipt::Accepted: return "accepted";
+    case Receipt::Duplicate: return "duplicate";
+    case Receipt::UnknownAgent: return "unknown agent";
+    case Receipt::WrongDimension: return "wrong dimension";
+    case Receipt::NonFinite: return "non-finite value";
+    case Receipt::ImpossibleStep: return "a step that cannot come yet";
+  }
+  return "?";
+}
+
+FormationMonitor::Receipt FormationMonitor::add(long id, long step, const std::vector<double>& position,
+                                                const std::vector<double>& previousPosition, long lastAllowed) {
   const int n = formation_.agentCount();
   const int d = formation_.dimension();
-  if (id < 0 || id >= n || step < next_) return false;
-  if (scenario_.steps > 0 && step > scenario_.steps) return false;
-  if (static_cast<int>(position.size()) != d || static_cast<int>(previousPosition.size()) != d) return false;
-  for (int a = 0; a < d; ++a) {
-    if (!std::isfinite(position[a]) || !std::isfinite(previousPosition[a])) return false;
+  if (id < 0 || id >= n) return Receipt::UnknownAgent;
+  if (static_cast<int>(position.size()) != d || static_cast<int>(previousPosition.size()) != d) {
+    return Receipt::WrongDimension;
   }
+  for (int a = 0; a < d; ++a) {
+    if (!std::isfinite(position[a]) || !std::isfinite(previousPosition[a])) return Receipt::NonFinite;
+  }
+  if (step < 0 || step > lastAllowed || (scenario_.steps > 0 && step > scenario_.steps)) return Receipt::ImpossibleStep;
+  if (step < next_) return Receipt::Duplicate;
   Pending& p = pending_[step];
   if (p.seen.empty()) {
     p.q.resize(d, n);
     p.qPrev.resize(d, n);
     p.seen.assign(static_cast<std::size_t>(n), false);
   }
-  if (p.seen[static_cast<std::size_t>(id)]) return false;
+  if (p.seen[static_cast<std::size_t>(id)]) return Receipt::Duplicate;
   p.seen[static_cast<std::size_t>(id)] = true;
   ++p.count;
   for (int a = 0; a < d; ++a) {
     p.q(a, id) = position[a];
     p.qPrev(a, id) = previousPosition[a];
   }
-  return true;
+  return Receipt::Accepted;
+}
+
+std::vector<int> FormationMonitor::missingAt(long step) const {
+  std::vector<int> missing;
+  const auto it = pending_.find(step);
+  for (int i = 0; i < formation_.agentCount(); ++i) {
+    if (it == pending_.end() || !it->second.seen[static_cast<std::size_t>(i)]) missing.push_back(i);
+  }
+  return missing;
 }
 
 std::vector<FormationSnapshot> FormationMonitor::takeCompleted() {

@@ -2,62 +2,128 @@
 
 #include <geometry_msgs/TransformStamped.h>
 #include <ros/callback_queue.h>
-#include <tf2_msgs/TFMessage.h>
 
 #include "variational_formation/ros/parameters.hpp"
+#include "variational_formation/ros/participants.hpp"
 
 namespace vf {
 
-AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+namespace {
+constexpr double kReportEvery = 5.0;  // seconds between "waiting for ..." lines
+}
+
+AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   const int id = requiredParam<int>(pnh, "id");
   const std::string path = requiredParam<std::string>(pnh, "scenario");
   realTimeFactor_ = optionalParam(pnh, "real_time_factor", 0.0);
-  extraSubscribers_ = optionalParam(pnh, "extra_subscribers", 1);
-  tfSubscribers_ = optionalParam(pnh, "tf_subscribers", 0);
+  monitor_ = participantName(nh, optionalParam<std::string>(pnh, "monitor", "monitor"));
   if (!(realTimeFactor_ >= 0.0)) throw InvalidInput("~real_time_factor: must be >= 0 (0 = as fast as possible)");
-  if (extraSubscribers_ < 0 || tfSubscribers_ < 0) throw InvalidInput("~extra_subscribers/~tf_subscribers: must be >= 0");
   const Scenario scenario = loadScenario(path);
   agent_ = std::make_unique<LockstepAgent>(scenario, id);
-  frame_ = "agent_" + std::to_string(id);
-  statePub_ = nh.advertise<AgentState>(frame_ + "/state", 1000, /*latch=*/true);
-  tfProbe_ = nh.advertise<tf2_msgs::TFMessage>("/tf", 100);
+  name_ = "agent_" + std::to_string(id);
+  // Frames carry the namespace, so that two formations side by side have distinct frames.
+  const std::string ns = nh.getNamespace() == "/" ? "" : nh.getNamespace().substr(1) + "/";
+  frame_ = ns + name_;
+  statePub_ = nh.advertise<AgentState>(name_ + "/state", 1000, /*latch=*/true);
   for (int j : agent_->neighbourIds()) {
-    subs_.push_back(nh.subscribe("agent_" + std::to_string(j) + "/state", 1000,
-                                             boost::function<void(const AgentState::ConstPtr&)>(
-                                                 [this, j](const AgentState::ConstPtr& m) { onState(j, m); }),
-                                 ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
+    neighbourOwners_.push_back(agentNodeName(nh, j));
+    subs_.push_back(nh.subscribe<AgentState>(
+        "agent_" + std::to_string(j) + "/state", 1000,
+        boost::function<void(const ros::MessageEvent<AgentState const>&)>(
+            [this, j](const ros::MessageEvent<AgentState const>& e) { onNeighbourState(j, e); }),
+        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
   }
-  for (const std::string& w : scenario.warnings) ROS_WARN("%s: %s", frame_.c_str(), w.c_str());
-  ROS_INFO("%s: scenario '%s' (%s), %d neighbours, kappa %g, h %g, %ld steps%s, real-time factor %g",
-           frame_.c_str(), scenario.name.c_str(), path.c_str(),
-           static_cast<int>(agent_->neighbourIds().size()), scenario.dampingGain, scenario.timeStep,
-           scenario.steps, scenario.steps == 0 ? " (unbounded)" : "", realTimeFactor_);
+  progressSub_ = nh.subscribe<RunProgress>(
+      "progress", 10,
+      boost::function<void(const ros::MessageEvent<RunProgress const>&)>(
+          [this](const ros::MessageEvent<RunProgress const>& e) { onProgress(e); }),
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  for (const std::string& w : scenario.warnings) ROS_WARN("%s: %s", name_.c_str(), w.c_str());
+  ROS_INFO("%s: scenario '%s' (%s), %d neighbours, kappa %g, h %g, %ld steps%s, real-time factor %g, monitor %s",
+           name_.c_str(), scenario.name.c_str(), path.c_str(), static_cast<int>(agent_->neighbourIds().size()),
+           scenario.dampingGain, scenario.timeStep, scenario.steps, scenario.steps == 0 ? " (unbounded)" : "",
+           realTimeFactor_, monitor_.c_str());
 }
 
-void AgentNode::onState(int expectedSender, const AgentState::ConstPtr& msg) {
+void AgentNode::drop(const std::string& why) {
+  ++dropped_;
+  ROS_WARN_THROTTLE(1.0, "%s: dropped %s; %ld dropped so far", name_.c_str(), why.c_str(), dropped_);
+}
+
+void AgentNode::onNeighbourState(int neighbour, const ros::MessageEvent<AgentState const>& event) {
   try {
-    const long sender = static_cast<long>(msg->id) == expectedSender ? expectedSender : -1;
-    const auto receipt = agent_->receive(sender, msg->step, msg->position, msg->previous_position);
-    if (receipt == LockstepAgent::Receipt::Accepted || receipt == LockstepAgent::Receipt::Duplicate) return;
-    ++dropped_;
-    ROS_WARN_THROTTLE(1.0, "%s: dropped a state from agent %u (step %ld): %s; %ld dropped so far",
-                      frame_.c_str(), msg->id, static_cast<long>(msg->step),
-                      LockstepAgent::describe(receipt).c_str(), dropped_);
+    const AgentState& msg = *event.getConstMessage();
+    std::size_t k = 0;
+    while (agent_->neighbourIds()[k] != neighbour) ++k;
+    if (!fromOwner(event, neighbourOwners_[k])) {
+      drop("a state on agent_" + std::to_string(neighbour) + "'s topic from " + event.getPublisherName() +
+           ", which does not own it");
+      return;
+    }
+    const long sender = static_cast<long>(msg.id) == neighbour ? neighbour : -1;
+    const auto receipt = agent_->receive(sender, msg.step, msg.position, msg.previous_position);
+    if (receipt == LockstepAgent::Receipt::Accepted) {
+      tryAdvance();
+    } else if (receipt != LockstepAgent::Receipt::Duplicate) {
+      drop("a state from agent_" + std::to_string(neighbour) + " (step " + std::to_string(msg.step) +
+           "): " + LockstepAgent::describe(receipt));
+    }
   } catch (const std::exception& e) {
-    ++dropped_;
-    ROS_WARN_THROTTLE(1.0, "%s: dropped a state: %s", frame_.c_str(), e.what());
+    drop(std::string("a state: ") + e.what());
+  }
+}
+
+void AgentNode::onProgress(const ros::MessageEvent<RunProgress const>& event) {
+  if (!fromOwner(event, monitor_)) {
+    drop("a progress message from " + event.getPublisherName() + ", which is not the monitor " + monitor_);
+    return;
+  }
+  const RunProgress& p = *event.getConstMessage();
+  if (p.state == RunProgress::FINISHED) {
+    ROS_INFO("%s: the monitor says the run is finished at step %ld; exiting", name_.c_str(), agent_->step());
+    exitStatus_ = 0;
+  } else if (p.state == RunProgress::FAILED) {
+    ROS_INFO("%s: the monitor says the run failed (%s); exiting", name_.c_str(), p.reason.c_str());
+    exitStatus_ = 1;
+  } else {
+    allowedStep_ = std::max(allowedStep_, static_cast<long>(p.allowed_step));
+    tryAdvance();
+  }
+}
+
+void AgentNode::tryAdvance() {
+  while (exitStatus_ < 0 && !agent_->finished() && agent_->step() < allowedStep_ && agent_->ready()) {
+    const ros::WallTime now = ros::WallTime::now();
+    if (!started_) {
+      started_ = true;
+      startedAt_ = now;
+    }
+    if (realTimeFactor_ > 0.0) {
+      // Step k + 1 is due (k + 1) h / r after the start.
+      const double due = (agent_->step() + 1) * agent_->scenario().timeStep / realTimeFactor_;
+      const double wait = due - (now - startedAt_).toSec();
+      if (wait > 0.0) {
+        paceTimer_ = nh_.createWallTimer(ros::WallDuration(wait), [this](const ros::WallTimerEvent&) { tryAdvance(); },
+                                         /*oneshot=*/true);
+        return;
+      }
+    }
+    agent_->advance();
+    publish();
+    lastStepAt_ = now;
   }
 }
 
 void AgentNode::publish() {
   AgentState msg;
-  msg.header.stamp = ros::Time::now();
+  msg.header.stamp.fromSec(agent_->time());
   msg.header.frame_id = "world";
   msg.id = static_cast<uint32_t>(agent_->id());
   msg.step = agent_->step();
   msg.time = agent_->time();
   msg.position = agent_->position();
   msg.previous_position = agent_->previousPosition();
+  msg.dropped = static_cast<uint32_t>(dropped_);
   statePub_.publish(msg);
 
   geometry_msgs::TransformStamped t;
@@ -70,45 +136,34 @@ void AgentNode::publish() {
   tf_.sendTransform(t);
 }
 
-void AgentNode::waitForSubscribers() {
-  // Every subscriber must be connected before step 0: then no step is missed by the monitor,
-  // the recorder or a neighbour (the latched state covers a connection that comes later).
-  const unsigned required = static_cast<unsigned>(agent_->neighbourIds().size() + extraSubscribers_);
-  ros::WallTime lastLog = ros::WallTime::now();
-  while (ros::ok() && (statePub_.getNumSubscribers() < required ||
-                       tfProbe_.getNumSubscribers() < static_cast<unsigned>(tfSubscribers_))) {
-    ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.005));
-    if ((ros::WallTime::now() - lastLog).toSec() > 5.0) {
-      ROS_INFO("%s: waiting for subscribers (%u of %u on the state, %u of %d on /tf)", frame_.c_str(),
-               statePub_.getNumSubscribers(), required, tfProbe_.getNumSubscribers(), tfSubscribers_);
-      lastLog = ros::WallTime::now();
-    }
+std::string AgentNode::waitingFor() const {
+  if (agent_->finished()) return "the monitor to end the run (last step " + std::to_string(agent_->step()) + " done)";
+  if (agent_->step() >= allowedStep_) {
+    return allowedStep_ == 0 ? "the monitor " + monitor_ + " to start the run (it waits for every participant)"
+                             : "the monitor " + monitor_ + " to allow step " + std::to_string(agent_->step() + 1) +
+                                   " (flow control: it or the recorder is behind)";
   }
+  std::string missing;
+  for (int j : agent_->neighbourIds()) {
+    if (!agent_->holdsNeighbourStep(j)) missing += (missing.empty() ? "" : ", ") + std::string("agent_") + std::to_string(j);
+  }
+  return missing.empty() ? "its pacing timer" : "the state at step " + std::to_string(agent_->step()) + " of " + missing;
 }
 
-void AgentNode::run() {
-  waitForSubscribers();
-  const ros::WallTime start = ros::WallTime::now();
-  publish();
-  auto* queue = ros::getGlobalCallbackQueue();
-  while (ros::ok() && !agent_->finished()) {
-    // Block only while a neighbour's state is missing: callAvailable returns as soon as one
-    // arrives, so a long timeout costs no latency and spares idle wake-ups (50 agents on 2 cores).
-    queue->callAvailable(agent_->ready() ? ros::WallDuration(0.0) : ros::WallDuration(0.1));
-    if (!agent_->ready()) continue;
-    if (realTimeFactor_ > 0.0) {
-      const double due = (agent_->step() + 1) * agent_->scenario().timeStep / realTimeFactor_;
-      const double wait = due - (ros::WallTime::now() - start).toSec();
-      if (wait > 0.0) ros::WallDuration(wait).sleep();
-    }
-    agent_->advance();
-    publish();
-  }
-  // Linger so that the last (latched) state reaches neighbours that are one step behind.
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(1.0);
-  while (ros::ok() && ros::WallTime::now() < end) queue->callAvailable(ros::WallDuration(0.01));
-  ROS_INFO("%s: done at step %ld in %.3f s, %ld malformed messages dropped", frame_.c_str(), agent_->step(),
-           (ros::WallTime::now() - start).toSec() - 1.0, dropped_);
+void AgentNode::reportWaiting() {
+  const ros::WallTime last = lastStepAt_.isZero() ? lastReportAt_ : std::max(lastStepAt_, lastReportAt_);
+  if (secondsSince(last) < kReportEvery) return;
+  ROS_INFO("%s: at step %ld, waiting for %s", name_.c_str(), agent_->step(), waitingFor().c_str());
+  lastReportAt_ = ros::WallTime::now();
+}
+
+int AgentNode::run() {
+  publish();  // step 0, latched: whoever connects later still gets it
+  lastReportAt_ = ros::WallTime::now();
+  watchTimer_ = nh_.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) { reportWaiting(); });
+  while (ros::ok() && exitStatus_ < 0) ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.1));
+  ROS_INFO("%s: done at step %ld, %ld states dropped", name_.c_str(), agent_->step(), dropped_);
+  return exitStatus_ < 0 ? 0 : exitStatus_;
 }
 
 }  // namespace vf

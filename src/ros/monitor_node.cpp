@@ -1,57 +1,134 @@
 #include "variational_formation/ros/monitor_node.hpp"
 
-#include <ros/callback_queue.h>
+#include <algorithm>
+#include <fstream>
 
-#include "variational_formation/FormationStatus.h"
+#include <ros/callback_queue.h>
+#include <ros/master.h>
+
 #include "variational_formation/ros/markers.hpp"
 #include "variational_formation/ros/parameters.hpp"
+#include "variational_formation/ros/participants.hpp"
 
 namespace vf {
 
-MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+namespace {
+constexpr double kReportEvery = 5.0;   // seconds between "waiting for ..." lines
+constexpr double kCheckAfter = 1.0;    // a step stalled this long makes the monitor look for dead participants
+constexpr double kLeaveTimeout = 5.0;  // seconds the agents get to leave after the end
+
+std::string agentList(const std::vector<int>& ids) {
+  std::string s;
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    if (k == 8) return s + " and " + std::to_string(ids.size() - k) + " more";
+    s += (k ? ", " : "") + std::string("agent_") + std::to_string(ids[k]);
+  }
+  return s;
+}
+}  // namespace
+
+MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   const std::string path = requiredParam<std::string>(pnh, "scenario");
   trailLength_ = optionalParam(pnh, "trail_length", 100);
-  statusSubscribers_ = optionalParam(pnh, "status_subscribers", 0);
-  markerSubscribers_ = optionalParam(pnh, "marker_subscribers", 0);
+  window_ = optionalParam(pnh, "window", 100);
+  const std::string recorder = optionalParam<std::string>(pnh, "recorder", "");
+  resultFile_ = optionalParam<std::string>(pnh, "result_file", "");
+  waitForViewer_ = optionalParam(pnh, "wait_for_viewer", false);
+  respawnTimeout_ = optionalParam(pnh, "respawn_timeout", 0.0);
   if (trailLength_ < 2) throw InvalidInput("~trail_length: must be >= 2");
-  if (statusSubscribers_ < 0 || markerSubscribers_ < 0) {
-    throw InvalidInput("~status_subscribers/~marker_subscribers: must be >= 0");
-  }
+  if (window_ < 1) throw InvalidInput("~window: must be >= 1, got " + std::to_string(window_));
+  if (!(respawnTimeout_ >= 0.0)) throw InvalidInput("~respawn_timeout: must be >= 0");
   monitor_ = std::make_unique<FormationMonitor>(loadScenario(path));
   const int n = monitor_->formation().agentCount();
   trails_.resize(static_cast<std::size_t>(n));
-  statusPub_ = nh.advertise<FormationStatus>("status", 1000);
-  markersPub_ = nh.advertise<visualization_msgs::MarkerArray>("markers", 1000);
-  for (int i = 0; i < n; ++i) {
-    subs_.push_back(nh.subscribe("agent_" + std::to_string(i) + "/state", 1000,
-                                             boost::function<void(const AgentState::ConstPtr&)>(
-                                                 [this, i](const AgentState::ConstPtr& m) { onState(i, m); }),
-                                 ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
+  if (!resultFile_.empty()) {
+    createParentDirectory(resultFile_, "~result_file");
+    std::ofstream probe(resultFile_);
+    if (!probe) throw InvalidInput("~result_file: cannot write '" + resultFile_ + "'");
+    probe << "result: running\n";
   }
-  ROS_INFO("monitor: scenario '%s' (%s), %d agents, %zu edges, %ld steps", monitor_->scenario().name.c_str(),
-           path.c_str(), n, monitor_->formation().edges().size(), monitor_->scenario().steps);
+  // Latched: a viewer or recorder that connects late still gets the newest step.
+  statusPub_ = nh.advertise<FormationStatus>("status", 1000, true);
+  markersPub_ = nh.advertise<visualization_msgs::MarkerArray>("markers", 1000, true);
+  progressPub_ = nh.advertise<RunProgress>("progress", 10, true);
+  for (int i = 0; i < n; ++i) {
+    agents_.push_back({agentNodeName(nh, i), false, ros::WallTime()});
+    subs_.push_back(nh.subscribe<AgentState>(
+        "agent_" + std::to_string(i) + "/state", static_cast<uint32_t>(2 * window_ + 10),
+        boost::function<void(const ros::MessageEvent<AgentState const>&)>(
+            [this, i](const ros::MessageEvent<AgentState const>& e) { onState(i, e); }),
+        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
+  }
+  recording_ = !recorder.empty();
+  if (recording_) {
+    recorder_.node = participantName(nh, recorder);
+    recorderSub_ = nh.subscribe<RunProgress>(
+        recorder + "/progress", 10,
+        boost::function<void(const ros::MessageEvent<RunProgress const>&)>(
+            [this](const ros::MessageEvent<RunProgress const>& e) { onRecorderProgress(e); }),
+        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  }
+  progress_.state = RunProgress::WAITING;
+  progress_.completed_step = -1;
+  progress_.allowed_step = 0;
+  ROS_INFO("monitor: scenario '%s' (%s), %d agents, %zu edges, %ld steps, window %ld, recorder %s%s",
+           monitor_->scenario().name.c_str(), path.c_str(), n, monitor_->formation().edges().size(),
+           monitor_->scenario().steps, window_, recording_ ? recorder_.node.c_str() : "none",
+           waitForViewer_ ? ", waits for a viewer" : "");
 }
 
-void MonitorNode::onState(int expectedSender, const AgentState::ConstPtr& msg) {
-  try {
-    if (static_cast<int>(msg->id) == expectedSender &&
-        monitor_->add(expectedSender, msg->step, msg->position, msg->previous_position)) {
-      return;
+void MonitorNode::onState(int agent, const ros::MessageEvent<AgentState const>& event) {
+  const AgentState& msg = *event.getConstMessage();
+  Participant& owner = agents_[static_cast<std::size_t>(agent)];
+  std::string why;
+  if (!fromOwner(event, owner.node)) {
+    why = "from " + event.getPublisherName() + ", which does not own it";
+  } else if (static_cast<int>(msg.id) != agent) {
+    why = "with id " + std::to_string(msg.id);
+  } else {
+    try {
+      const auto receipt =
+          monitor_->add(agent, msg.step, msg.position, msg.previous_position, progress_.allowed_step);
+      if (receipt == FormationMonitor::Receipt::Accepted || receipt == FormationMonitor::Receipt::Duplicate) {
+        owner.seen = true;
+        owner.goneSince = ros::WallTime();
+        if (receipt == FormationMonitor::Receipt::Accepted) publishCompleted();
+        return;
+      }
+      why = "(step " + std::to_string(msg.step) + "): " + FormationMonitor::describe(receipt);
+    } catch (const std::exception& e) {
+      why = e.what();
     }
-    // A state already completed (a latched repeat) is no error.
-    if (static_cast<int>(msg->id) == expectedSender && msg->step < monitor_->nextStep()) return;
-    ++dropped_;
-    ROS_WARN_THROTTLE(1.0, "monitor: dropped a malformed state on agent_%d's topic (id %u, step %ld); %ld so far",
-                      expectedSender, msg->id, static_cast<long>(msg->step), dropped_);
-  } catch (const std::exception& e) {
-    ++dropped_;
-    ROS_WARN_THROTTLE(1.0, "monitor: dropped a state: %s", e.what());
   }
+  ++dropped_;
+  ROS_WARN_THROTTLE(1.0, "monitor: dropped a state on agent_%d's topic %s; %ld dropped so far", agent, why.c_str(),
+                    dropped_);
+}
+
+void MonitorNode::onRecorderProgress(const ros::MessageEvent<RunProgress const>& event) {
+  if (!fromOwner(event, recorder_.node)) {
+    ++dropped_;
+    ROS_WARN_THROTTLE(1.0, "monitor: dropped a recorder progress from %s, which is not %s",
+                      event.getPublisherName().c_str(), recorder_.node.c_str());
+    return;
+  }
+  const RunProgress& p = *event.getConstMessage();
+  recorder_.seen = true;
+  recorder_.goneSince = ros::WallTime();
+  if (p.state == RunProgress::FAILED) {
+    finish(RunProgress::FAILED, "the recorder failed: " + p.reason);
+    return;
+  }
+  recordedStep_ = std::max(recordedStep_, static_cast<long>(p.completed_step));
+  recorderDone_ = p.state == RunProgress::FINISHED;
+  updateProgress();
 }
 
 void MonitorNode::publishCompleted() {
+  const ros::WallTime now = ros::WallTime::now();
   for (const FormationSnapshot& s : monitor_->takeCompleted()) {
-    if (s.metrics.step == 0) firstStepAt_ = ros::WallTime::now();
+    if (s.metrics.step == 0) firstStepAt_ = now;
+    lastCompletedAt_ = now;
     for (int i = 0; i < monitor_->formation().agentCount(); ++i) {
       auto& trail = trails_[static_cast<std::size_t>(i)];
       Eigen::Vector3d p = Eigen::Vector3d::Zero();
@@ -59,8 +136,16 @@ void MonitorNode::publishCompleted() {
       trail.push_back(p);
       if (static_cast<int>(trail.size()) > trailLength_) trail.pop_front();
     }
-    statusPub_.publish(toStatusMessage(s));
-    markersPub_.publish(makeMarkers(s, monitor_->formation(), trails_));
+    ros::Time stamp;
+    stamp.fromSec(s.metrics.time);  // simulated time t_k
+    FormationStatus status = toStatusMessage(s);
+    status.header.stamp = stamp;
+    status.dropped = static_cast<uint32_t>(dropped_);
+    statusPub_.publish(status);
+    visualization_msgs::MarkerArray markers = makeMarkers(s, monitor_->formation(), trails_);
+    for (auto& m : markers.markers) m.header.stamp = stamp;
+    markersPub_.publish(markers);
+    convergedStep_ = s.converged ? s.convergedStep : -1;
     if (s.converged && reportedConvergence_ != s.convergedStep) {
       ROS_INFO("monitor: congruent with the desired shape since step %ld (t = %.3f s)", s.convergedStep,
                s.convergedStep * monitor_->scenario().timeStep);
@@ -70,30 +155,157 @@ void MonitorNode::publishCompleted() {
       reportedConvergence_ = -2;
     }
   }
+  updateProgress();
 }
 
-void MonitorNode::run() {
-  auto* queue = ros::getGlobalCallbackQueue();
-  // Hold every step until the recorder and rviz (if any) listen, so that they miss nothing.
-  while (ros::ok() && (statusPub_.getNumSubscribers() < static_cast<unsigned>(statusSubscribers_) ||
-                       markersPub_.getNumSubscribers() < static_cast<unsigned>(markerSubscribers_))) {
-    queue->callAvailable(ros::WallDuration(0.005));
-  }
+void MonitorNode::updateProgress() {
+  if (exitStatus_ >= 0) return;
   const long last = monitor_->scenario().steps;
-  while (ros::ok() && (last == 0 || monitor_->nextStep() <= last)) {
-    queue->callAvailable(ros::WallDuration(0.1));  // returns as soon as a state arrives
-    publishCompleted();
+  const long completed = completedStep();
+  const long base = recording_ ? std::min(completed, recordedStep_) : completed;
+  RunProgress next = progress_;
+  next.completed_step = base;
+  if (progress_.state == RunProgress::WAITING) {
+    // Start by identity: every agent's step 0 is here (completed), the recorder holds step 0,
+    // and, if asked, a viewer listens to the markers.
+    const bool viewer = !waitForViewer_ || markersPub_.getNumSubscribers() > 0;
+    if (base < 0 || !viewer) return;
+    next.state = RunProgress::RUNNING;
+    startedAt_ = ros::WallTime::now();
   }
-  if (!ros::ok()) return;
-  const double seconds = (ros::WallTime::now() - firstStepAt_).toSec();
-  const double h = monitor_->scenario().timeStep;
-  ROS_INFO("monitor: %ld steps in %.3f s: %.0f steps/s, real-time factor %.1f at h = %g; %s; %ld dropped",
-           last, seconds, last / seconds, last * h / seconds, h,
-           reportedConvergence_ >= 0 ? ("converged at step " + std::to_string(reportedConvergence_)).c_str()
-                                     : "not converged",
-           dropped_);
-  // Let the recorder take the last messages before roslaunch tears the run down.
-  ros::WallDuration(1.0).sleep();
+  next.allowed_step = base + window_;
+  if (last > 0) next.allowed_step = std::min<long>(next.allowed_step, last);
+  if (last > 0 && completed >= last && (!recording_ || recorderDone_)) {
+    finish(RunProgress::FINISHED, "");
+    return;
+  }
+  // Publish on every change of state, and otherwise every quarter window: agents never wait
+  // for a step the window already allows.
+  const long every = std::max<long>(1, window_ / 4);
+  if (next.state != progress_.state || next.allowed_step >= progress_.allowed_step + every ||
+      (next.allowed_step > progress_.allowed_step && next.allowed_step == last)) {
+    next.header.stamp.fromSec(std::max(0L, base) * monitor_->scenario().timeStep);
+    progress_ = next;
+    progressPub_.publish(progress_);
+  }
+}
+
+std::string MonitorNode::waitingFor() const {
+  const long next = monitor_->nextStep();
+  const std::vector<int> missing = monitor_->missingAt(next);
+  if (!missing.empty()) return "step " + std::to_string(next) + " of " + agentList(missing);
+  if (recording_ && recordedStep_ < completedStep()) {
+    return "the recorder " + recorder_.node + " (it holds steps up to " + std::to_string(recordedStep_) + ")";
+  }
+  if (progress_.state == RunProgress::WAITING && waitForViewer_) return "a viewer (rviz) on the markers";
+  return "nothing";
+}
+
+bool MonitorNode::checkAlive(Participant& p, const std::string& what) {
+  if (!p.seen) return true;  // not started yet: the waiting line says so
+  const Liveness l = nodeLiveness(p.node);
+  if (l == Liveness::Alive) {
+    p.goneSince = ros::WallTime();
+    return true;
+  }
+  if (p.goneSince.isZero()) {
+    p.goneSince = ros::WallTime::now();
+    if (respawnTimeout_ > 0.0) {
+      ROS_WARN("monitor: %s %s is gone (%s); waiting up to %.1f s for it to come back", what.c_str(), p.node.c_str(),
+               describe(l), respawnTimeout_);
+    }
+  }
+  if (secondsSince(p.goneSince) < respawnTimeout_) return true;
+  finish(RunProgress::FAILED, what + " " + p.node + " ended before the run was over (" + describe(l) + ")");
+  return false;
+}
+
+void MonitorNode::watch() {
+  if (exitStatus_ >= 0) return;
+  const ros::WallTime since = lastCompletedAt_.isZero() ? startedAt_ : lastCompletedAt_;
+  const double stalled = since.isZero() ? kCheckAfter : secondsSince(since);
+  if (stalled >= kCheckAfter) {
+    for (int i : monitor_->missingAt(monitor_->nextStep())) {
+      if (!checkAlive(agents_[static_cast<std::size_t>(i)], "agent_" + std::to_string(i))) return;
+    }
+    if (recording_ && !checkAlive(recorder_, "the recorder")) return;
+  }
+  updateProgress();  // a viewer may have come
+  if (stalled >= kReportEvery && secondsSince(lastReportAt_) >= kReportEvery) {
+    std::vector<int> unseen;
+    for (std::size_t i = 0; i < agents_.size(); ++i) {
+      if (!agents_[i].seen) unseen.push_back(static_cast<int>(i));
+    }
+    ROS_INFO("monitor: step %ld complete, waiting for %s%s", completedStep(), waitingFor().c_str(),
+             unseen.empty() ? "" : ("; not heard yet: " + agentList(unseen)).c_str());
+    lastReportAt_ = ros::WallTime::now();
+  }
+}
+
+void MonitorNode::writeResult(const std::string& result, const std::string& reason) const {
+  if (resultFile_.empty()) return;
+  std::ofstream f(resultFile_);
+  std::string quoted;
+  for (char c : reason) quoted += c == '"' ? std::string("\\\"") : std::string(1, c);
+  f << "result: " << result << "\nscenario: " << monitor_->scenario().name
+    << "\nsteps: " << monitor_->scenario().steps << "\ncompleted_step: " << completedStep()
+    << "\nconverged_step: " << convergedStep_ << "\ndropped: " << dropped_ << "\nreason: \"" << quoted << "\"\n";
+  if (!f) ROS_ERROR("monitor: cannot write the result file %s", resultFile_.c_str());
+}
+
+void MonitorNode::finish(uint8_t state, const std::string& reason) {
+  if (exitStatus_ >= 0) return;
+  const long last = completedStep();
+  if (state == RunProgress::FINISHED) {
+    const double seconds = (ros::WallTime::now() - firstStepAt_).toSec();
+    const double h = monitor_->scenario().timeStep;
+    writeResult("succeeded", "");
+    ROS_INFO("monitor: %ld steps in %.3f s: %.0f steps/s, real-time factor %.1f at h = %g; %s; %ld dropped", last,
+             seconds, last / seconds, last * h / seconds, h,
+             reportedConvergence_ >= 0 ? ("converged at step " + std::to_string(reportedConvergence_)).c_str()
+                                       : "not converged",
+             dropped_);
+    ROS_INFO("monitor: run succeeded (%s)", resultFile_.empty() ? "no result file" : resultFile_.c_str());
+    exitStatus_ = 0;
+  } else {
+    writeResult("failed", reason);
+    ROS_ERROR("monitor: run failed at step %ld: %s", last, reason.c_str());
+    exitStatus_ = 1;
+  }
+  progress_.state = state;
+  progress_.reason = reason;
+  progressPub_.publish(progress_);
+}
+
+int MonitorNode::run() {
+  lastReportAt_ = ros::WallTime::now();
+  progressPub_.publish(progress_);
+  watchTimer_ = nh_.createWallTimer(ros::WallDuration(0.5), [this](const ros::WallTimerEvent&) { watch(); });
+  auto* queue = ros::getGlobalCallbackQueue();
+  while (ros::ok() && exitStatus_ < 0) queue->callAvailable(ros::WallDuration(0.1));
+  if (exitStatus_ < 0) {
+    // Shut down from outside (Ctrl-C, roslaunch): an unbounded run is stopped, a bounded one failed.
+    if (monitor_->scenario().steps == 0) {
+      writeResult("stopped", "stopped at step " + std::to_string(completedStep()));
+      ROS_INFO("monitor: run stopped at step %ld", completedStep());
+      return 0;
+    }
+    const std::string reason = "interrupted before the last step, waiting for " + waitingFor();
+    writeResult("failed", reason);
+    ROS_ERROR("monitor: run failed at step %ld: %s", completedStep(), reason.c_str());
+    return 1;
+  }
+  // Give the agents and the recorder the final word: wait until they have left (or 5 s).
+  const ros::WallTime end = ros::WallTime::now();
+  while (ros::ok() && secondsSince(end) < kLeaveTimeout) {
+    queue->callAvailable(ros::WallDuration(0.1));
+    std::vector<std::string> nodes;
+    if (!ros::master::getNodes(nodes)) break;
+    bool anyLeft = recording_ && std::find(nodes.begin(), nodes.end(), recorder_.node) != nodes.end();
+    for (const Participant& a : agents_) anyLeft = anyLeft || std::find(nodes.begin(), nodes.end(), a.node) != nodes.end();
+    if (!anyLeft) break;
+  }
+  return exitStatus_;
 }
 
 }  // namespace vf

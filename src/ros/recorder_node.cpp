@@ -1,79 +1,171 @@
 #include "variational_formation/ros/recorder_node.hpp"
 
 #include <ros/callback_queue.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include "variational_formation/ros/parameters.hpp"
+#include "variational_formation/ros/participants.hpp"
 
 namespace vf {
 
 namespace {
-constexpr uint32_t kQueue = 1000000;  // a whole run: nothing is dropped while the disk catches up
+constexpr uint32_t kQueue = 100000;  // far more than the monitor's window lets the agents run ahead
+
+/// Bag time of a message stamped with simulated time t_k (a bag cannot hold time 0).
+ros::Time bagTime(const ros::Time& stamp) { return std::max(stamp, ros::TIME_MIN); }
+}  // namespace
+
+bool RecorderNode::Steps::add(long step) {
+  if (step < next || ahead.count(step)) return false;
+  ahead.insert(step);
+  while (!ahead.empty() && *ahead.begin() == next) {
+    ahead.erase(ahead.begin());
+    ++next;
+  }
+  return true;
 }
 
-template <typename M>
-void RecorderNode::subscribe(ros::NodeHandle& nh, const std::string& topic,
-                             std::function<void(const M&)> count) {
-  subs_.push_back(nh.subscribe(topic, kQueue, boost::function<void(const typename M::ConstPtr&)>(
-                                                  [this, topic, count](const typename M::ConstPtr& m) {
-                                                    try {
-                                                      bag_.write(topic, ros::Time::now(), *m);
-                                                      ++written_;
-                                                      count(*m);
-                                                    } catch (const std::exception& e) {
-                                                      ROS_ERROR_THROTTLE(1.0, "recorder: %s", e.what());
-                                                    }
-                                                  }),
-                               ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
-}
-
-RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   const Scenario scenario = loadScenario(requiredParam<std::string>(pnh, "scenario"));
   path_ = requiredParam<std::string>(pnh, "bag");
+  monitor_ = participantName(nh, optionalParam<std::string>(pnh, "monitor", "monitor"));
   steps_ = scenario.steps;
-  agents_ = scenario.agentCount();
-  stateCount_.assign(static_cast<std::size_t>(agents_), 0);
-  tfCount_.assign(static_cast<std::size_t>(agents_), 0);
+  timeStep_ = scenario.timeStep;
+  const int n = scenario.agentCount();
+  states_.resize(static_cast<std::size_t>(n));
+  createParentDirectory(path_, "~bag");
   try {
     bag_.open(path_, rosbag::bagmode::Write);
+    open_ = true;
   } catch (const std::exception& e) {
     throw InvalidInput("~bag: cannot write '" + path_ + "': " + e.what());
   }
-  for (int i = 0; i < agents_; ++i) {
-    subscribe<AgentState>(nh, "/formation/agent_" + std::to_string(i) + "/state",
-                          [this, i](const AgentState&) { ++stateCount_[static_cast<std::size_t>(i)]; });
+  const std::string ns = nh.getNamespace() == "/" ? "" : nh.getNamespace().substr(1) + "/";
+  framePrefix_ = ns;
+  for (int i = 0; i < n; ++i) {
+    owners_.push_back(agentNodeName(nh, i));
+    subs_.push_back(nh.subscribe<AgentState>(
+        "agent_" + std::to_string(i) + "/state", kQueue,
+        boost::function<void(const ros::MessageEvent<AgentState const>&)>(
+            [this, i](const ros::MessageEvent<AgentState const>& e) { onState(i, e); }),
+        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
   }
-  subscribe<FormationStatus>(nh, "/formation/status", [this](const FormationStatus&) { ++statusCount_; });
-  subscribe<visualization_msgs::MarkerArray>(nh, "/formation/markers",
-                                             [this](const visualization_msgs::MarkerArray&) { ++markerCount_; });
-  subscribe<tf2_msgs::TFMessage>(nh, "/tf", [this](const tf2_msgs::TFMessage& m) {
-    for (const auto& t : m.transforms) {
-      const std::string prefix = "agent_";
-      if (t.child_frame_id.rfind(prefix, 0) != 0) continue;
-      try {
-        const int i = std::stoi(t.child_frame_id.substr(prefix.size()));
-        if (i >= 0 && i < agents_) ++tfCount_[static_cast<std::size_t>(i)];
-      } catch (const std::exception&) {
-      }
-    }
-  });
-  ROS_INFO("recorder: writing %s (%d agents, %ld steps)", path_.c_str(), agents_, steps_);
+  subs_.push_back(nh.subscribe<FormationStatus>(
+      "status", kQueue,
+      boost::function<void(const ros::MessageEvent<FormationStatus const>&)>(
+          [this](const ros::MessageEvent<FormationStatus const>& e) { onStatus(e); }),
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
+  subs_.push_back(nh.subscribe<visualization_msgs::MarkerArray>(
+      "markers", kQueue,
+      boost::function<void(const ros::MessageEvent<visualization_msgs::MarkerArray const>&)>(
+          [this](const ros::MessageEvent<visualization_msgs::MarkerArray const>& e) { onMarkers(e); }),
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
+  subs_.push_back(nh.subscribe<RunProgress>(
+      "progress", 10,
+      boost::function<void(const ros::MessageEvent<RunProgress const>&)>(
+          [this](const ros::MessageEvent<RunProgress const>& e) { onMonitorProgress(e); })));
+  progressPub_ = pnh.advertise<RunProgress>("progress", 10, true);
+  progress_.state = RunProgress::WAITING;
+  progress_.completed_step = -1;
+  ROS_INFO("recorder: writing %s (%d agents, %ld steps), monitor %s", path_.c_str(), n, steps_, monitor_.c_str());
 }
 
-bool RecorderNode::complete() const {
-  if (steps_ == 0) return false;
-  const long each = steps_ + 1;
-  for (int i = 0; i < agents_; ++i) {
-    if (stateCount_[static_cast<std::size_t>(i)] < each || tfCount_[static_cast<std::size_t>(i)] < each) return false;
+template <typename M>
+void RecorderNode::write(const std::string& topic, const M& msg, const ros::Time& stamp) {
+  if (!open_) return;
+  try {
+    bag_.write(topic, bagTime(stamp), msg);
+    ++written_;
+  } catch (const std::exception& e) {
+    progress_.state = RunProgress::FAILED;
+    progress_.reason = std::string("cannot write ") + path_ + ": " + e.what();
+    progressPub_.publish(progress_);
+    ROS_ERROR("recorder: %s", progress_.reason.c_str());
+    close("failed");
+    exitStatus_ = 1;
   }
-  return statusCount_ >= each && markerCount_ >= each;
 }
 
-void RecorderNode::run() {
-  auto* queue = ros::getGlobalCallbackQueue();
-  while (ros::ok() && !complete()) queue->callAvailable(ros::WallDuration(0.01));
+void RecorderNode::onState(int agent, const ros::MessageEvent<AgentState const>& event) {
+  const AgentState& msg = *event.getConstMessage();
+  if (!fromOwner(event, owners_[static_cast<std::size_t>(agent)]) || static_cast<int>(msg.id) != agent) {
+    ++dropped_;
+    ROS_WARN_THROTTLE(1.0, "recorder: dropped a state on agent_%d's topic from %s; %ld dropped so far", agent,
+                      event.getPublisherName().c_str(), dropped_);
+    return;
+  }
+  write(nh_.resolveName("agent_" + std::to_string(agent) + "/state"), msg, msg.header.stamp);
+  if (!states_[static_cast<std::size_t>(agent)].add(msg.step)) {
+    ++repeats_;  // a repeat is written as received; it must equal the first (doc/distributed.md)
+    return;
+  }
+  tf2_msgs::TFMessage tf;
+  tf.transforms.resize(1);
+  auto& t = tf.transforms[0];
+  t.header = msg.header;
+  t.child_frame_id = framePrefix_ + "agent_" + std::to_string(agent);
+  t.transform.translation.x = msg.position.size() > 0 ? msg.position[0] : 0.0;
+  t.transform.translation.y = msg.position.size() > 1 ? msg.position[1] : 0.0;
+  t.transform.translation.z = msg.position.size() > 2 ? msg.position[2] : 0.0;
+  t.transform.rotation.w = 1.0;
+  write("/tf", tf, msg.header.stamp);
+  report();
+}
+
+void RecorderNode::onStatus(const ros::MessageEvent<FormationStatus const>& event) {
+  if (!fromOwner(event, monitor_)) return;
+  const FormationStatus& msg = *event.getConstMessage();
+  write(nh_.resolveName("status"), msg, msg.header.stamp);
+  if (status_.add(msg.step)) report();
+}
+
+void RecorderNode::onMarkers(const ros::MessageEvent<visualization_msgs::MarkerArray const>& event) {
+  if (!fromOwner(event, monitor_)) return;
+  const auto& msg = *event.getConstMessage();
+  write(nh_.resolveName("markers"), msg, msg.markers.empty() ? ros::TIME_MIN : msg.markers[0].header.stamp);
+  ++markers_;
+  report();
+}
+
+void RecorderNode::onMonitorProgress(const ros::MessageEvent<RunProgress const>& event) {
+  if (!fromOwner(event, monitor_)) return;
+  const RunProgress& p = *event.getConstMessage();
+  if (p.state == RunProgress::FINISHED || p.state == RunProgress::FAILED) {
+    close(p.state == RunProgress::FINISHED ? "finished" : "the run failed");
+    exitStatus_ = 0;
+  }
+}
+
+void RecorderNode::report() {
+  if (progress_.state == RunProgress::FAILED || progress_.state == RunProgress::FINISHED) return;
+  // Complete up to k: every agent's states and the status up to k, and the markers have come.
+  long complete = status_.next - 1;
+  for (const Steps& s : states_) complete = std::min(complete, s.next - 1);
+  if (markers_ == 0) complete = -1;
+  if (complete <= progress_.completed_step) return;
+  progress_.completed_step = complete;
+  progress_.header.stamp.fromSec(static_cast<double>(complete) * timeStep_);
+  progress_.state = RunProgress::RUNNING;
+  if (steps_ > 0 && complete >= steps_) {
+    close("complete");
+    progress_.state = RunProgress::FINISHED;
+  }
+  progressPub_.publish(progress_);
+}
+
+void RecorderNode::close(const std::string& how) {
+  if (!open_) return;
+  open_ = false;
   bag_.close();
-  ROS_INFO("recorder: %s closed, %ld messages%s", path_.c_str(), written_,
-           complete() ? " (every step of every stream)" : " (interrupted)");
+  ROS_INFO("recorder: %s closed (%s): %ld messages, %ld repeated states, %ld dropped", path_.c_str(), how.c_str(),
+           written_, repeats_, dropped_);
+}
+
+int RecorderNode::run() {
+  auto* queue = ros::getGlobalCallbackQueue();
+  while (ros::ok() && exitStatus_ < 0) queue->callAvailable(ros::WallDuration(0.1));
+  close("interrupted");
+  return exitStatus_ < 0 ? 0 : exitStatus_;
 }
 
 }  // namespace vf

@@ -1,5 +1,7 @@
 // LockstepAgent: the distributed protocol without transport. Agents that exchange states in
 // any order (with losses made good by later states) reproduce the centralised run bit for bit.
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include <random>
@@ -115,7 +117,8 @@ TEST(Monitor, MetricsFromAgentStatesMatchTheCentralisedIntegrator) {
     if (k > 0) vi.step();
     for (int i = 0; i < s.agentCount(); ++i) {
       const Eigen::VectorXd q = vi.positions().col(i), qp = vi.previousPositions().col(i);
-      ASSERT_TRUE(monitor.add(i, k, {q.data(), q.data() + 3}, {qp.data(), qp.data() + 3}));
+      ASSERT_EQ(monitor.add(i, k, {q.data(), q.data() + 3}, {qp.data(), qp.data() + 3}, s.steps),
+                FormationMonitor::Receipt::Accepted);
     }
     const auto done = monitor.takeCompleted();
     ASSERT_EQ(done.size(), 1u);
@@ -129,10 +132,27 @@ TEST(Monitor, MetricsFromAgentStatesMatchTheCentralisedIntegrator) {
       EXPECT_EQ(done[0].convergedStep, 847);  // as measured with simulate (config comment)
     }
   }
-  EXPECT_FALSE(monitor.add(0, 3, {0, 0, 0}, {0, 0, 0}));  // step already completed
-  EXPECT_FALSE(monitor.add(7, s.steps, {0, 0, 0}, {0, 0, 0}));          // unknown agent
-  EXPECT_FALSE(monitor.add(0, s.steps + 1, {0, 0, 0}, {0, 0, 0}));      // beyond the last step
-  EXPECT_FALSE(monitor.add(0, s.steps, {0, 0}, {0, 0}));                // wrong dimension
+  using R = FormationMonitor::Receipt;
+  const long all = s.steps + 10;
+  EXPECT_EQ(monitor.add(0, 3, {0, 0, 0}, {0, 0, 0}, all), R::Duplicate);  // step already completed
+  EXPECT_EQ(monitor.add(7, s.steps, {0, 0, 0}, {0, 0, 0}, all), R::UnknownAgent);
+  EXPECT_EQ(monitor.add(0, s.steps + 1, {0, 0, 0}, {0, 0, 0}, all), R::ImpossibleStep);  // past the last step
+  EXPECT_EQ(monitor.add(0, s.steps, {0, 0}, {0, 0}, all), R::WrongDimension);
+  EXPECT_EQ(monitor.add(0, s.steps, {0, NAN, 0}, {0, 0, 0}, all), R::NonFinite);
+}
+
+TEST(Monitor, BuffersNothingPastTheAllowedStepAndNamesTheMissingAgents) {
+  const Scenario s = loadScenario(test::configPath("hexagon"));
+  FormationMonitor monitor(s);
+  using R = FormationMonitor::Receipt;
+  const std::vector<double> q{1, 2};
+  EXPECT_EQ(monitor.add(0, 5, q, q, 4), R::ImpossibleStep);  // the agents may not be there yet
+  EXPECT_EQ(monitor.add(0, 0, q, q, 4), R::Accepted);
+  EXPECT_EQ(monitor.add(0, 0, q, q, 4), R::Duplicate);
+  EXPECT_EQ(monitor.add(2, 0, q, q, 4), R::Accepted);
+  EXPECT_EQ(monitor.missingAt(0), (std::vector<int>{1, 3, 4, 5}));
+  EXPECT_EQ(monitor.missingAt(1), (std::vector<int>{0, 1, 2, 3, 4, 5}));
+  EXPECT_TRUE(monitor.takeCompleted().empty());
 }
 
 }  // namespace

@@ -1,137 +1,115 @@
 #!/usr/bin/python3
-"""rostest: watches a distributed run (launch/formation.launch) and checks it.
+"""rostest (distributed_run.test): a recorded run of formation.launch, checked from its bag.
 
 Private parameters:
   scenario          name in config/ (required)
   expect            converged | planar | free_particle
-  real_time_factor  if > 0, the run must take steps * h / real_time_factor of wall time
-Every run is checked for: each agent's states 0..N exactly once (no gap, no duplicate), every
-agent's every step equal to `simulate`'s bit for bit, the status of every step, and the
-Noether laws on the status messages.
+  real_time_factor  > 0: the run is paced, and status k arrives about k h / r after status 0
+  output_dir        where formation.launch writes the bag and the result file (removed after)
+  injected          a foreign node forged states of agent_0: they must all have been dropped
 """
-import csv
 import math
 import os
-import subprocess
+import shutil
 import sys
-import tempfile
 import threading
+import time
 import unittest
 
-import rospkg
 import rospy
 import rostest
-import yaml
-from variational_formation.msg import AgentState, FormationStatus
+from variational_formation.msg import FormationStatus
 
-PKG = "variational_formation"
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import vf_rostest  # noqa: E402
 
 
-class DistributedRun(unittest.TestCase):
+class DistributedRun(unittest.TestCase, vf_rostest.RunChecks):
     @classmethod
     def setUpClass(cls):
         rospy.init_node("distributed_run_test")
-        name = rospy.get_param("~scenario")
+        cls.name = rospy.get_param("~scenario")
         cls.expect = rospy.get_param("~expect", "converged")
-        cls.path = os.path.join(rospkg.RosPack().get_path(PKG), "config", name + ".yaml")
-        with open(cls.path) as f:
-            cls.scenario = yaml.safe_load(f)
-        cls.n = len(cls.scenario["agents"])
-        cls.steps = int(cls.scenario["steps"])
-        cls.h = float(cls.scenario["time_step"])
-        cls.kappa = float(cls.scenario["kappa"])
-        cls.states = {i: [] for i in range(cls.n)}
-        cls.status = []
-        cls.lock = threading.Lock()
-        cls.done = threading.Event()
-
-        def on_state(msg, i):
-            if msg.header.frame_id == "injected":  # inject_malformed.py's, not the agent's
-                return
-            with cls.lock:
-                cls.states[i].append(msg)
+        cls.rate = float(rospy.get_param("~real_time_factor", 0.0))
+        cls.injected = bool(rospy.get_param("~injected", False))
+        cls.out = rospy.get_param("~output_dir")
+        cls.path = vf_rostest.scenario_path(cls.name)
+        cls.scenario = vf_rostest.load_scenario(cls.path)
+        cls.arrivals = []  # (wall time, step) of live status messages, for the pacing check
+        lock = threading.Lock()
 
         def on_status(msg):
-            with cls.lock:
-                cls.status.append(msg)
-            if msg.step >= cls.steps:
-                cls.done.set()
+            with lock:
+                cls.arrivals.append((time.monotonic(), msg.step))
 
-        cls.subs = [rospy.Subscriber(f"/formation/agent_{i}/state", AgentState, on_state, i, queue_size=100000)
-                    for i in range(cls.n)]
-        cls.subs.append(rospy.Subscriber("/formation/status", FormationStatus, on_status, queue_size=100000))
-        cls.finished = cls.done.wait(timeout=float(rospy.get_param("~timeout", 90.0)))
-        rospy.sleep(0.5)  # the agents' last states trail the last status by nothing; be generous
+        cls.sub = rospy.Subscriber("/formation/status", FormationStatus, on_status, queue_size=100000)
+        name = os.path.basename(cls.path).replace(".yaml", "")
+        cls.result = vf_rostest.wait_for_result(os.path.join(cls.out, name + ".result.yaml"), 120.0)
+        cls.recording = None
+        if cls.result.get("result") == "succeeded":
+            cls.recording = vf_rostest.Recording(os.path.join(cls.out, name + ".bag"))
+        cls.expected = vf_rostest.simulate(cls.path)
 
-    def test_00_run_finished(self):
-        self.assertTrue(self.finished, "no status for the last step arrived")
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.out, ignore_errors=True)
 
-    def test_every_step_of_every_agent_exactly_once(self):
-        for i in range(self.n):
-            steps = [m.step for m in self.states[i]]
-            self.assertEqual(steps, list(range(self.steps + 1)), f"agent {i}")
-        self.assertEqual([s.step for s in self.status], list(range(self.steps + 1)))
+    def setUp(self):
+        self.assertEqual(self.result.get("result"), "succeeded", f"result file: {self.result}")
 
-    def test_bitwise_equal_to_simulate(self):
-        with tempfile.TemporaryDirectory() as tmp:
-            out = os.path.join(tmp, "traj.csv")
-            subprocess.run(["rosrun", PKG, "simulate", "--scenario", self.path, "--out", out], check=True)
-            with open(out) as f:
-                rows = list(csv.DictReader(f))
-        self.assertEqual(len(rows), (self.steps + 1) * self.n)
-        d = int(self.scenario["dimension"])
-        mismatches = 0
-        for row in rows:
-            k, i = int(row["step"]), int(row["agent"])
-            expected = [float(row[c]) for c in "xyz"[:d]]
-            got = list(self.states[i][k].position)
-            if got != expected:  # exact: %.17g round-trips a double
-                mismatches += 1
-        self.assertEqual(mismatches, 0, f"{mismatches} of {len(rows)} positions differ from simulate")
-
-    def test_pacing(self):
-        # With a real-time factor r, step k is due k h / r after step 0.
-        rtf = float(rospy.get_param("~real_time_factor", 0.0))
-        if rtf > 0.0:
-            first, last = self.status[0].header.stamp, self.status[-1].header.stamp
-            due = self.steps * self.h / rtf
-            self.assertGreater((last - first).to_sec(), 0.95 * due)
-            self.assertLess((last - first).to_sec(), 1.5 * due + 1.0)
-
-    def test_noether_laws_on_status(self):
-        for s in self.status:
-            for x, pred in ((s.linear_momentum, s.linear_momentum_predicted),
-                            (s.angular_momentum, s.angular_momentum_predicted)):
-                scale = max(1.0, math.sqrt(pred.x ** 2 + pred.y ** 2 + pred.z ** 2))
-                err = math.sqrt((x.x - pred.x) ** 2 + (x.y - pred.y) ** 2 + (x.z - pred.z) ** 2)
-                self.assertLess(err / scale, 1e-9, f"step {s.step}")
+    def test_recording_is_complete_and_equals_simulate(self):
+        self.check_recording(self.recording, self.scenario, self.expected)
 
     def test_expected_outcome(self):
-        last = self.status[-1]
+        last = self.recording.status[int(self.scenario["steps"])][0]
+        n = self.scenario["n"]
         if self.expect == "converged":
             self.assertTrue(last.converged, f"max distance error {last.max_distance_error}")
             self.assertGreaterEqual(last.converged_step, 0)
+            self.assertEqual(self.result["converged_step"], last.converged_step)
             self.assertLess(last.max_distance_error, 0.05)
-            self.assertLess(last.energy, 1e-2 * self.status[0].energy)
+            self.assertLess(last.energy, 1e-2 * self.recording.status[0][0].energy)
         elif self.expect == "planar":
             # The paper's start lies in the plane 3x - y = 3 and never leaves it.
-            for i in range(self.n):
-                for m in self.states[i]:
-                    x, y, _ = m.position
-                    self.assertLess(abs(3 * x - y - 3), 1e-9, f"agent {i} step {m.step}")
+            for (i, k), (m,) in self.recording.states.items():
+                x, y, _ = m.position
+                self.assertLess(abs(3 * x - y - 3), 1e-9, f"agent {i} step {k}")
             self.assertFalse(last.converged)
         elif self.expect == "free_particle":
             # v_{k+1} = e^{-kappa h} v_k exactly, to the round-off of difference quotients.
-            a = math.exp(-self.kappa * self.h)
-            states = self.states[0]
-            for k in range(2, self.steps + 1):
-                v1 = [(p - q) / self.h for p, q in zip(states[k].position, states[k].previous_position)]
-                v0 = [(p - q) / self.h for p, q in zip(states[k - 1].position, states[k - 1].previous_position)]
-                for c in range(3):
+            h, a = float(self.scenario["time_step"]), math.exp(-float(self.scenario["kappa"]) * float(self.scenario["time_step"]))
+            for k in range(2, int(self.scenario["steps"]) + 1):
+                (s1,), (s0,) = self.recording.states[(0, k)], self.recording.states[(0, k - 1)]
+                v1 = [(p - q) / h for p, q in zip(s1.position, s1.previous_position)]
+                v0 = [(p - q) / h for p, q in zip(s0.position, s0.previous_position)]
+                for c in range(len(v1)):
                     self.assertAlmostEqual(v1[c], a * v0[c], delta=1e-10)
         else:
             self.fail(f"unknown ~expect {self.expect}")
+        self.assertEqual(n, len({i for i, _ in self.recording.states}))
+
+    def test_paced_at_the_real_time_factor(self):
+        if self.rate <= 0:
+            self.skipTest("unpaced run (real_time_factor 0): nothing to time")
+        # Status k is due k h / r after status 0; take the stretch this subscriber saw.
+        (t0, k0), (t1, k1) = self.arrivals[0], self.arrivals[-1]
+        self.assertGreater(k1 - k0, int(self.scenario["steps"]) // 2)
+        due = (k1 - k0) * float(self.scenario["time_step"]) / self.rate
+        self.assertGreater(t1 - t0, 0.95 * due)
+        self.assertLess(t1 - t0, 1.5 * due + 1.0)
+
+    def test_forged_states_were_dropped_and_counted(self):
+        if not self.injected:
+            self.skipTest("no foreign node forged states in this run")
+        published = rospy.get_param("/inject_forged/published", 0)
+        self.assertGreater(published, 50, "the forger published too little to test anything")
+        last = int(self.scenario["steps"])
+        for j in self.scenario["neighbours"][0]:
+            (m,) = self.recording.states[(j, last)]
+            self.assertGreater(m.dropped, 0, f"agent_{j}, a neighbour of agent_0, dropped nothing")
+        self.assertGreater(self.recording.status[last][0].dropped, 0, "the monitor dropped nothing")
+        self.assertGreaterEqual(self.result["dropped"], self.recording.status[last][0].dropped)
 
 
 if __name__ == "__main__":
-    rostest.rosrun(PKG, "distributed_run_test", DistributedRun, sys.argv)
+    rostest.rosrun(vf_rostest.PKG, "distributed_run_test", DistributedRun, sys.argv)

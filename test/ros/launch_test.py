@@ -1,117 +1,247 @@
 #!/usr/bin/python3
-"""rostest: whole launches, run as a user would (roslaunch in a subprocess, on the test's master).
+"""rostest (launch.test): whole launches as a user runs them (roslaunch and run_formation.sh in
+subprocesses, on the test's master), with real faults.
 
-- The recorded bag holds every step of every agent, status, markers and tf, with no gap and no
-  duplicate.
-- A bad scenario makes the nodes exit non-zero with a one-line error naming the field.
-- A bad launch argument ends the launch with a one-line error naming it.
+- A recorded run through run_formation.sh succeeds (exit 0) and rviz renders its bag.
+- Bad input (a missing scenario, kappa -1, a bad edge, a bad order or rate, an unwritable
+  output_dir) ends the launch with one line naming the cause, and run_formation.sh exits non-zero.
+- An agent killed with SIGKILL, or with `rosnode kill`, ends the run: the monitor's line names it,
+  the result file says failed, run_formation.sh exits non-zero.
+- Agents started first, each by its own agent.launch (as on robots), with stray subscribers on
+  their topics, wait for the monitor and recorder started later (agents:=false): the bag is still
+  complete and equals simulate.
+- Flow control: while the monitor is stopped (SIGSTOP), no agent runs past the allowed step.
 - A bad node parameter is one ROS_FATAL line naming it and exit status 2.
-- The recorded bag, replayed into rviz under Xvfb with the shipped config, renders the agents:
-  the screenshot contains the agent marker colours.
 """
 import colorsys
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
 import time
 import unittest
+import xmlrpc.client
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.image  # noqa: E402
 import numpy as np  # noqa: E402
-import rosbag  # noqa: E402
-import rospkg  # noqa: E402
+import rosgraph  # noqa: E402
+import rospy  # noqa: E402
 import rostest  # noqa: E402
 import yaml  # noqa: E402
+from variational_formation.msg import AgentState, FormationStatus, RunProgress  # noqa: E402
 
-PKG = "variational_formation"
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import vf_rostest  # noqa: E402
+
+PKG = vf_rostest.PKG
 SCENARIO = "hexagon"
 # Agent colours of src/ros/markers.cpp (agentColour), for the agents of the hexagon.
 PALETTE = [(0.90, 0.10, 0.10), (0.10, 0.45, 0.90), (0.10, 0.75, 0.20), (0.95, 0.60, 0.05),
            (0.60, 0.20, 0.80), (0.05, 0.80, 0.80)]
 
 
-def launch(*args, timeout=180):
-    return subprocess.run(["roslaunch", PKG, "formation.launch", *args], capture_output=True,
-                          text=True, timeout=timeout)
+def run_formation(*args, timeout=120):
+    return subprocess.run(["rosrun", PKG, "run_formation.sh", *args], capture_output=True, text=True,
+                          timeout=timeout)
 
 
-class LaunchTest(unittest.TestCase):
+def start(cmd):
+    return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            start_new_session=True)
+
+
+def node_pid(name, timeout=20.0):
+    master = rosgraph.Master("/launch_test")
+    end = time.time() + timeout
+    while time.time() < end:
+        try:
+            return xmlrpc.client.ServerProxy(master.lookupNode(name)).getPid("/launch_test")[2]
+        except Exception:
+            time.sleep(0.1)
+    raise AssertionError(f"{name} did not come up")
+
+
+class StepWatcher:
+    """The newest step seen on the status topic."""
+
+    def __init__(self):
+        self.step = -1
+        self.sub = rospy.Subscriber("/formation/status", FormationStatus, self.on_status, queue_size=1000)
+
+    def on_status(self, msg):
+        self.step = max(self.step, msg.step)
+
+    def wait_for(self, step, timeout=30.0):
+        end = time.time() + timeout
+        while self.step < step and time.time() < end:
+            time.sleep(0.02)
+        return self.step >= step
+
+
+class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
     @classmethod
     def setUpClass(cls):
+        rospy.init_node("launch_test")
         cls.tmp = tempfile.mkdtemp(prefix="vf_launch_test_")
-        cls.pkg = rospkg.RosPack().get_path(PKG)
-        with open(os.path.join(cls.pkg, "config", SCENARIO + ".yaml")) as f:
-            cls.scenario = yaml.safe_load(f)
-        cls.recording = launch(f"scenario:={SCENARIO}", "record:=true", f"output_dir:={cls.tmp}")
+        cls.path = vf_rostest.scenario_path(SCENARIO)
+        cls.scenario = vf_rostest.load_scenario(cls.path)
+        cls.recording = run_formation(f"scenario:={SCENARIO}", "record:=true", f"output_dir:={cls.tmp}")
         cls.bag = os.path.join(cls.tmp, SCENARIO + ".bag")
 
     @classmethod
     def tearDownClass(cls):
         shutil.rmtree(cls.tmp, ignore_errors=True)
 
-    def test_bag_holds_every_step_once(self):
-        self.assertEqual(self.recording.returncode, 0, self.recording.stderr[-2000:])
-        n, steps = len(self.scenario["agents"]), int(self.scenario["steps"])
-        states = {i: [] for i in range(n)}
-        status, markers, tf = [], 0, {i: 0 for i in range(n)}
-        with rosbag.Bag(self.bag) as bag:
-            for topic, msg, _ in bag.read_messages():
-                if topic.endswith("/state"):
-                    states[msg.id].append(msg.step)
-                    self.assertEqual(topic, f"/formation/agent_{msg.id}/state")
-                elif topic == "/formation/status":
-                    status.append(msg.step)
-                elif topic == "/formation/markers":
-                    markers += 1
-                elif topic == "/tf":
-                    for t in msg.transforms:
-                        self.assertEqual(t.header.frame_id, "world")
-                        tf[int(t.child_frame_id.split("_")[1])] += 1
-        expected = list(range(steps + 1))
-        for i in range(n):
-            self.assertEqual(states[i], expected, f"agent {i}")
-            self.assertEqual(tf[i], steps + 1, f"tf of agent {i}")
-        self.assertEqual(status, expected)
-        self.assertEqual(markers, steps + 1)
-
-    def test_bad_scenario_fails_naming_the_field(self):
-        bad = dict(self.scenario)
-        bad["edges"] = list(self.scenario["edges"]) + [[0, 9]]
-        path = os.path.join(self.tmp, "bad.yaml")
+    def scenario_variant(self, name, **fields):
+        s = {k: v for k, v in self.scenario.items() if k not in ("n", "neighbours")}
+        s.update(fields)
+        path = os.path.join(self.tmp, name + ".yaml")
         with open(path, "w") as f:
-            yaml.safe_dump(bad, f)
-        run = launch(f"scenario:={path}", timeout=60)
-        out = run.stdout + run.stderr
-        errors = [line for line in out.splitlines() if "agent 9 does not exist" in line]
-        self.assertTrue(errors, out[-3000:])
-        for line in errors:
-            self.assertIn("edges[9]", line)
-        self.assertIn("exit code 2", out)  # roslaunch reports the nodes' status
+            yaml.safe_dump(s, f)
+        return path
 
-    def test_bad_launch_argument_ends_the_launch(self):
-        # The spawner is required: its one-line error ends the launch (launch() times out if not).
-        for arg, words in (("order:=sideways", "argument --order"), ("rate:=-1", "--rate and --stagger")):
-            run = launch(f"scenario:={SCENARIO}", arg, timeout=60)
+    def test_recorded_run_succeeds(self):
+        self.assertEqual(self.recording.returncode, 0, self.recording.stderr[-3000:])
+        with open(os.path.join(self.tmp, SCENARIO + ".result.yaml")) as f:
+            self.assertEqual(yaml.safe_load(f)["result"], "succeeded")
+
+    def test_bad_input_is_one_line_and_a_failure(self):
+        bad_edge = self.scenario_variant("bad_edge", edges=list(self.scenario["edges"]) + [[0, 9]])
+        cases = (
+            ([f"scenario:={self.tmp}/missing.yaml"], "make_agents_launch: error:", "cannot open the scenario file"),
+            ([f"scenario:={self.scenario_variant('negative_kappa', kappa=-1.0)}"], "make_agents_launch: error:",
+             "kappa: must be finite and >= 0, got -1"),
+            ([f"scenario:={bad_edge}"], "make_agents_launch: error:", "edges[9]: agent 9 does not exist"),
+            ([f"scenario:={SCENARIO}", "order:=sideways"], "make_agents_launch: error:", "order: invalid choice"),
+            ([f"scenario:={SCENARIO}", "rate:=-1"], "make_agents_launch: error:", "rate: must be a finite number >= 0"),
+            ([f"scenario:={SCENARIO}", "output_dir:=/etc/hostname/out"], "FATAL",
+             "~result_file: cannot create the directory"),
+        )
+        for args, marker, words in cases:
+            run = run_formation(*args, timeout=60)
             out = run.stdout + run.stderr
-            errors = [line for line in out.splitlines() if line.startswith("spawn_agents: error:")]
-            self.assertEqual(len(errors), 1, out[-3000:])
-            self.assertIn(words, errors[0])
+            lines = [line for line in out.splitlines() if marker in line]
+            self.assertNotEqual(run.returncode, 0, f"{args}: {out[-3000:]}")
+            self.assertEqual(len(lines), 1, f"{args}: {out[-3000:]}")
+            self.assertIn(words, lines[0], args)
+
+    def check_killed_agent_fails_the_run(self, kill, victim):
+        out = os.path.join(self.tmp, "killed")
+        watcher = StepWatcher()
+        run = start(["rosrun", PKG, "run_formation.sh", f"scenario:={SCENARIO}", "rate:=1", f"output_dir:={out}"])
+        try:
+            self.assertTrue(watcher.wait_for(60), "the run did not start")
+            kill(victim)
+            killed_at = time.time()
+            log, _ = run.communicate(timeout=40)
+            ended_after = time.time() - killed_at
+        finally:
+            watcher.sub.unregister()
+            if run.poll() is None:
+                os.killpg(run.pid, signal.SIGINT)
+                run.wait(timeout=30)
+        self.assertNotEqual(run.returncode, 0, log[-3000:])
+        failed = [line for line in log.splitlines() if "monitor: run failed at step" in line]
+        self.assertEqual(len(failed), 1, log[-3000:])
+        self.assertIn(victim, failed[0])
+        with open(os.path.join(out, SCENARIO + ".result.yaml")) as f:
+            result = yaml.safe_load(f)
+        self.assertEqual(result["result"], "failed")
+        self.assertIn(victim, result["reason"])
+        self.assertLess(ended_after, 15.0, "the launch took too long to end after the kill")
+
+    def test_agent_killed_with_sigkill_fails_the_run_naming_it(self):
+        self.check_killed_agent_fails_the_run(lambda name: os.kill(node_pid(name), signal.SIGKILL),
+                                              "/formation/agent_3")
+
+    def test_agent_ended_with_rosnode_kill_fails_the_run_naming_it(self):
+        self.check_killed_agent_fails_the_run(
+            lambda name: subprocess.run(["rosnode", "kill", name], capture_output=True, check=True),
+            "/formation/agent_2")
+
+    def test_agents_started_elsewhere_wait_for_the_monitor_and_recorder(self):
+        out = os.path.join(self.tmp, "elsewhere")
+        stray = [start(["rostopic", "echo", "-n", "1000000", f"/formation/agent_{i}/state"]) for i in (0, 1)]
+        stray.append(start(["rostopic", "echo", "-n", "1000000", "/formation/status"]))
+        agents = [start(["roslaunch", PKG, "agent.launch", f"id:={i}", f"scenario:={SCENARIO}"])
+                  for i in range(self.scenario["n"])]
+        try:
+            time.sleep(6.5)  # the agents are up and wait for the monitor, saying so
+            run = run_formation(f"scenario:={SCENARIO}", "agents:=false", "record:=true", f"output_dir:={out}")
+            self.assertEqual(run.returncode, 0, run.stdout[-3000:] + run.stderr[-2000:])
+            logs = []
+            for a in agents:
+                log, _ = a.communicate(timeout=30)
+                logs.append(log)
+                self.assertEqual(a.returncode, 0, log[-2000:])
+        finally:
+            for p in stray + agents:
+                if p.poll() is None:
+                    os.killpg(p.pid, signal.SIGINT)
+                    p.wait(timeout=30)
+        self.assertTrue(all("waiting for the monitor /formation/monitor to start the run" in log for log in logs),
+                        logs[0][-2000:])
+        rec = vf_rostest.Recording(os.path.join(out, SCENARIO + ".bag"))
+        self.check_recording(rec, self.scenario, vf_rostest.simulate(self.path))
+
+    def test_agents_never_run_past_the_window_while_the_monitor_is_stopped(self):
+        unbounded = self.scenario_variant("unbounded", steps=0)
+        window = 40
+        steps, allowed = {}, [0]
+
+        def on_state(msg, i):
+            if msg._connection_header.get("callerid") == f"/formation/agent_{i}":
+                steps[i] = (max(steps.get(i, (-1, 0))[0], msg.step), time.time())
+
+        def on_progress(msg):
+            allowed[0] = max(allowed[0], msg.allowed_step)
+
+        subs = [rospy.Subscriber(f"/formation/agent_{i}/state", AgentState, on_state, i, queue_size=100000)
+                for i in range(self.scenario["n"])]
+        subs.append(rospy.Subscriber("/formation/progress", RunProgress, on_progress, queue_size=1000))
+        watcher = StepWatcher()
+        out = os.path.join(self.tmp, "window")
+        run = start(["rosrun", PKG, "run_formation.sh", f"scenario:={unbounded}", f"window:={window}",
+                     f"output_dir:={out}"])
+        try:
+            self.assertTrue(watcher.wait_for(300), "the run did not start")
+            monitor = node_pid("/formation/monitor")
+            os.kill(monitor, signal.SIGSTOP)
+            time.sleep(1.5)
+            held = dict(steps)
+            time.sleep(1.0)
+            self.assertEqual({i: s for i, (s, _) in steps.items()}, {i: s for i, (s, _) in held.items()},
+                             "agents moved while the monitor was stopped")
+            stopped_at = watcher.step
+            self.assertLessEqual(max(s for s, _ in steps.values()), allowed[0])
+            self.assertLessEqual(allowed[0], stopped_at + window)
+            os.kill(monitor, signal.SIGCONT)
+            self.assertTrue(watcher.wait_for(stopped_at + 500), "the run did not go on after SIGCONT")
+        finally:
+            for s in subs:
+                s.unregister()
+            watcher.sub.unregister()
+            os.killpg(run.pid, signal.SIGINT)
+            log, _ = run.communicate(timeout=40)
+        self.assertEqual(run.returncode, 0, log[-3000:])  # an unbounded run stopped by the user
+        with open(os.path.join(out, "unbounded.result.yaml")) as f:
+            self.assertEqual(yaml.safe_load(f)["result"], "stopped")
 
     def test_bad_node_parameters_are_one_fatal_line(self):
-        scenario = os.path.join(self.pkg, "config", SCENARIO + ".yaml")
         cases = (("monitor", ["_trail_length:=abc"], "~trail_length: expected an integer"),
                  ("monitor", ["_trail_length:=1"], "~trail_length: must be >= 2"),
+                 ("monitor", ["_window:=0"], "~window: must be >= 1"),
                  ("agent", ["_id:=1", "_real_time_factor:=fast"], "~real_time_factor: expected a number"),
                  ("agent", ["_id:=99"], "id: must be an agent id 0..5, got 99"),
                  ("agent", [], "~id: required parameter missing"))
         for k, (node, params, words) in enumerate(cases):
             # A fresh node name each time: private parameters stay on the master after a run.
-            run = subprocess.run(["rosrun", PKG, node, f"__name:=param_probe_{k}", f"_scenario:={scenario}",
+            run = subprocess.run(["rosrun", PKG, node, f"__name:=param_probe_{k}", f"_scenario:={self.path}",
                                   *params], capture_output=True, text=True, timeout=30)
             fatal = [line for line in (run.stdout + run.stderr).splitlines() if "FATAL" in line]
             self.assertEqual(run.returncode, 2, f"{node} {params}: {run.stdout[-1000:]}{run.stderr[-1000:]}")
@@ -127,13 +257,14 @@ class LaunchTest(unittest.TestCase):
             procs.append(subprocess.Popen(["Xvfb", display, "-screen", "0", "1280x900x24"],
                                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
             time.sleep(2)
-            subprocess.run(["rosparam", "set", "/use_sim_time", "true"], check=True)
-            procs.append(subprocess.Popen(["rviz", "-d", os.path.join(self.pkg, "config", "formation.rviz")],
+            # The bag's time is the simulated time: replayed with --clock, rviz runs on it.
+            rospy.set_param("/use_sim_time", True)
+            procs.append(subprocess.Popen(["rviz", "-d", os.path.join(rospkg_path(), "config", "formation.rviz")],
                                           env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
             time.sleep(8)
             procs.append(subprocess.Popen(["rosbag", "play", "--clock", "-q", "-r", "0.5", self.bag],
                                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
-            time.sleep(8)
+            time.sleep(6)
             dump = os.path.join(self.tmp, "shot.xwd")
             with open(dump, "wb") as f:
                 subprocess.run(["xwd", "-root", "-silent", "-display", display], stdout=f, check=True)
@@ -143,6 +274,7 @@ class LaunchTest(unittest.TestCase):
             if keep:
                 shutil.copy(png, keep)
         finally:
+            rospy.delete_param("/use_sim_time")
             for p in reversed(procs):
                 p.terminate()
                 try:
@@ -156,6 +288,11 @@ class LaunchTest(unittest.TestCase):
             distance = np.minimum(abs(hsv[:, :, 0] - hue), 1 - abs(hsv[:, :, 0] - hue))
             matches = (distance < 0.02) & (hsv[:, :, 1] > 0.5) & (hsv[:, :, 2] > 0.25)
             self.assertGreater(int(matches.sum()), 30, f"agent {i}'s colour {rgb} is not in the screenshot")
+
+
+def rospkg_path():
+    import rospkg
+    return rospkg.RosPack().get_path(PKG)
 
 
 if __name__ == "__main__":

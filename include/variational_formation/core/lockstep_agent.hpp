@@ -33,6 +33,8 @@ class LockstepAgent {
                   const std::vector<double>& previousPosition);
   /// Every neighbour's q_k is known.
   bool ready() const;
+  /// Neighbour j's q_k is known.
+  bool holdsNeighbourStep(int j) const;
   /// q_k -> q_{k+1}. Requires ready().
   void advance();
 

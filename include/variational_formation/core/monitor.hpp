@@ -1,6 +1,7 @@
 #pragma once
 
 #include <map>
+#include <string>
 #include <vector>
 
 #include "variational_formation/core/scenario.hpp"
@@ -31,10 +32,17 @@ class FormationMonitor {
  public:
   explicit FormationMonitor(const Scenario& scenario, double tolerance = 0.01, double maxSpeed = 0.1);
 
-  /// Stores agent `id`'s state at `step`. @return false (and stores nothing) if the id, sizes,
-  /// values or step are invalid, or the step was already completed.
-  bool add(long id, long step, const std::vector<double>& position,
-           const std::vector<double>& previousPosition);
+  /// What became of an offered state.
+  enum class Receipt { Accepted, Duplicate, UnknownAgent, WrongDimension, NonFinite, ImpossibleStep };
+  static std::string describe(Receipt receipt);
+
+  /// Stores agent `id`'s state at `step` unless it is invalid (stores nothing then) or already
+  /// held or completed (Duplicate). Steps past `lastAllowed` are impossible: the agents never
+  /// compute them, which bounds what is buffered.
+  Receipt add(long id, long step, const std::vector<double>& position, const std::vector<double>& previousPosition,
+              long lastAllowed);
+  /// Agents whose state at `step` has not arrived (all of them if none has).
+  std::vector<int> missingAt(long step) const;
   /// Completed steps in order, each removed from the buffer once returned.
   std::vector<FormationSnapshot> takeCompleted();
 

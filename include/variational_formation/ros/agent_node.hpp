@@ -1,49 +1,66 @@
 #pragma once
 
+#include <memory>
 #include <string>
+#include <vector>
 
 #include <ros/ros.h>
 #include <tf2_ros/transform_broadcaster.h>
 
 #include "variational_formation/AgentState.h"
-#include "variational_formation/FormationStatus.h"
+#include "variational_formation/RunProgress.h"
 #include "variational_formation/core/lockstep_agent.hpp"
 
 namespace vf {
 
 using variational_formation::AgentState;
-using variational_formation::FormationStatus;
+using variational_formation::RunProgress;
 
 /**
- * ROS I/O of one agent (DESIGN.md §3): subscribes to its neighbours' states, publishes its own
- * (latched) and the tf world -> agent_<id>. All maths is LockstepAgent's.
+ * ROS I/O of one agent in lockstep mode (doc/distributed.md). Event-driven: every callback ends
+ * in tryAdvance(), which computes as many steps as the neighbours' states, the monitor's
+ * allowed step and the pacing permit. All maths is LockstepAgent's.
+ *
+ * It publishes its state at once (latched, step 0 included) and the tf world -> <ns>/agent_<id>;
+ * it accepts a neighbour's state only from the node that owns it, and it computes step k only
+ * once the monitor's latched `progress` allows k. It exits 0 when the monitor says the run is
+ * finished, 1 when the monitor says it failed.
+ *
  * Private parameters: ~id, ~scenario (required), ~real_time_factor (0 = as fast as possible),
- * ~extra_subscribers (subscribers of the state topic besides the neighbours, default 1: the
- * monitor), ~tf_subscribers (subscribers of /tf to wait for, default 0).
+ * ~monitor (name of the monitor node, relative to the namespace; default "monitor").
  */
 class AgentNode {
  public:
   /// @throws InvalidInput on a missing or bad parameter or scenario.
   AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
-  /// Runs to the scenario's last step (forever for steps: 0) or until shutdown.
-  void run();
-  long dropped() const { return dropped_; }
+  /// Spins until the monitor ends the run (or shutdown). @return the exit status.
+  int run();
 
  private:
-  void onState(int expectedSender, const AgentState::ConstPtr& msg);
+  void onNeighbourState(int neighbour, const ros::MessageEvent<AgentState const>& event);
+  void onProgress(const ros::MessageEvent<RunProgress const>& event);
+  void tryAdvance();
   void publish();
-  void waitForSubscribers();
+  void reportWaiting();
+  std::string waitingFor() const;
+  void drop(const std::string& why);
 
+  ros::NodeHandle nh_;
   std::unique_ptr<LockstepAgent> agent_;
   ros::Publisher statePub_;
-  ros::Publisher tfProbe_;  // same /tf topic as the broadcaster: tells who listens
   std::vector<ros::Subscriber> subs_;
+  std::vector<std::string> neighbourOwners_;  // full node names, indexed like neighbourIds()
+  ros::Subscriber progressSub_;
+  std::string monitor_;
   tf2_ros::TransformBroadcaster tf_;
+  ros::WallTimer paceTimer_, watchTimer_;
   double realTimeFactor_ = 0.0;
-  int extraSubscribers_ = 1;
-  int tfSubscribers_ = 0;
+  long allowedStep_ = 0;
+  bool started_ = false;
+  ros::WallTime startedAt_, lastStepAt_, lastReportAt_;
   long dropped_ = 0;
-  std::string frame_;
+  int exitStatus_ = -1;  // -1: running
+  std::string name_, frame_;
 };
 
 }  // namespace vf

@@ -2,46 +2,82 @@
 
 #include <deque>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <ros/ros.h>
 
 #include "variational_formation/AgentState.h"
 #include "variational_formation/FormationStatus.h"
+#include "variational_formation/RunProgress.h"
 #include "variational_formation/core/monitor.hpp"
 
 namespace vf {
 
 using variational_formation::AgentState;
 using variational_formation::FormationStatus;
+using variational_formation::RunProgress;
 
 /**
- * ROS I/O of the monitor: subscribes to every agent's state, publishes /formation/status and
- * /formation/markers for each completed step, and reports convergence. Maths: FormationMonitor.
- * Private parameters: ~scenario (required), ~trail_length (default 100), ~status_subscribers and
- * ~marker_subscribers (subscribers to wait for before publishing step 0, default 0).
+ * The referee of a run (doc/distributed.md): collects every agent's states (only from the node
+ * that owns each agent), publishes `status` and `markers` for each completed step, and the
+ * latched `progress` that starts the agents once every participant is there and holds them at
+ * most ~window steps ahead of what it and the recorder have completed. It says every few
+ * seconds what a stalled run waits for, ends the run as failed when a participant dies, and
+ * writes the outcome to ~result_file. Maths: FormationMonitor.
+ *
+ * Private parameters: ~scenario (required), ~trail_length (100), ~window (100), ~recorder (name
+ * of the recorder node, "" = no recording), ~result_file ("" = none), ~wait_for_viewer (false:
+ * with true, the start also waits for a subscriber of `markers`, i.e. rviz), ~respawn_timeout
+ * (seconds a dead agent may take to come back before the run fails; 0 = fail at once).
  */
 class MonitorNode {
  public:
   /// @throws InvalidInput on a missing or bad parameter or scenario.
   MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
-  /// Runs until the scenario's last step is published (forever for steps: 0) or shutdown.
-  void run();
+  /// Until the run ends (or shutdown). @return the exit status: 0 finished, 1 failed.
+  int run();
 
  private:
-  void onState(int expectedSender, const AgentState::ConstPtr& msg);
+  struct Participant {
+    std::string node;            // full node name
+    bool seen = false;           // has sent a valid message
+    ros::WallTime goneSince;     // zero while alive
+  };
+  void onState(int agent, const ros::MessageEvent<AgentState const>& event);
+  void onRecorderProgress(const ros::MessageEvent<RunProgress const>& event);
   void publishCompleted();
+  void updateProgress();
+  void watch();
+  bool checkAlive(Participant& p, const std::string& what);
+  std::string waitingFor() const;
+  void finish(uint8_t state, const std::string& reason);
+  void writeResult(const std::string& result, const std::string& reason) const;
+  long completedStep() const { return monitor_->nextStep() - 1; }
 
+  ros::NodeHandle nh_;
   std::unique_ptr<FormationMonitor> monitor_;
   std::vector<ros::Subscriber> subs_;
-  ros::Publisher statusPub_, markersPub_;
+  ros::Subscriber recorderSub_;
+  ros::Publisher statusPub_, markersPub_, progressPub_;
+  ros::WallTimer watchTimer_;
+  std::vector<Participant> agents_;
+  Participant recorder_;
+  bool recording_ = false;
+  long recordedStep_ = -1;
+  bool recorderDone_ = false;
   std::vector<std::deque<Eigen::Vector3d>> trails_;
   int trailLength_ = 100;
-  int statusSubscribers_ = 0;
-  int markerSubscribers_ = 0;
+  long window_ = 100;
+  bool waitForViewer_ = false;
+  double respawnTimeout_ = 0.0;
+  std::string resultFile_;
+  RunProgress progress_;
   long dropped_ = 0;
   long reportedConvergence_ = -2;
-  ros::WallTime firstStepAt_;
+  long convergedStep_ = -1;
+  ros::WallTime firstStepAt_, lastCompletedAt_, lastReportAt_, startedAt_;
+  int exitStatus_ = -1;
 };
 
 }  // namespace vf

@@ -1,47 +1,72 @@
 #pragma once
 
+#include <set>
 #include <string>
 #include <vector>
 
 #include <ros/ros.h>
 #include <rosbag/bag.h>
-#include <tf2_msgs/TFMessage.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include "variational_formation/AgentState.h"
 #include "variational_formation/FormationStatus.h"
+#include "variational_formation/RunProgress.h"
 #include "variational_formation/core/scenario.hpp"
 
 namespace vf {
 
 using variational_formation::AgentState;
 using variational_formation::FormationStatus;
+using variational_formation::RunProgress;
 
 /**
- * Records a run to a bag: every agent state, status, marker array and /tf message. Unlike
- * `rosbag record` (a fixed queue of 100 per topic, which drops messages when a fast run
- * outpaces it), it subscribes with queues that hold a whole run, and it knows the scenario, so
- * it closes the bag and exits once the last step of every stream is written.
- * Private parameters: ~scenario, ~bag (both required).
+ * Records a run to a bag, losslessly (doc/distributed.md): every agent state (only from the node
+ * that owns the agent), every status and marker array of the monitor, and /tf written from the
+ * recorded states (the transforms the agents broadcast: /tf is not latched, so a recorder that
+ * subscribed to it could miss the first step). It is a named participant: it reports on
+ * `~progress` the last step of which it has written every agent state and the status, and the
+ * monitor holds the agents back until it has. Bag time is the simulated time t_k, so
+ * `rosbag play --clock` replays the run at the simulated pace.
+ *
+ * Private parameters: ~scenario, ~bag (both required), ~monitor (default "monitor").
  */
 class RecorderNode {
  public:
   RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
-  /// Until every stream's last step is written (or shutdown for unbounded runs).
-  void run();
+  /// Until the monitor ends the run (or shutdown). @return the exit status.
+  int run();
 
  private:
+  /// Steps of one stream written so far: all below `next`, and some beyond it.
+  struct Steps {
+    long next = 0;
+    std::set<long> ahead;
+    /// @return true if the step is new.
+    bool add(long step);
+  };
   template <typename M>
-  void subscribe(ros::NodeHandle& nh, const std::string& topic, std::function<void(const M&)> count);
-  bool complete() const;
+  void write(const std::string& topic, const M& msg, const ros::Time& stamp);
+  void onState(int agent, const ros::MessageEvent<AgentState const>& event);
+  void onStatus(const ros::MessageEvent<FormationStatus const>& event);
+  void onMarkers(const ros::MessageEvent<visualization_msgs::MarkerArray const>& event);
+  void onMonitorProgress(const ros::MessageEvent<RunProgress const>& event);
+  void report();
+  void close(const std::string& how);
 
+  ros::NodeHandle nh_;
   rosbag::Bag bag_;
-  std::string path_;
+  std::string path_, monitor_, framePrefix_, stateTopicPrefix_;
   std::vector<ros::Subscriber> subs_;
+  ros::Publisher progressPub_;
+  RunProgress progress_;
   long steps_ = 0;
-  int agents_ = 0;
-  std::vector<long> stateCount_, tfCount_;
-  long statusCount_ = 0, markerCount_ = 0, written_ = 0;
+  double timeStep_ = 0.0;
+  std::vector<std::string> owners_;
+  std::vector<Steps> states_;
+  Steps status_;
+  long markers_ = 0, written_ = 0, repeats_ = 0, dropped_ = 0;
+  bool open_ = false;
+  int exitStatus_ = -1;
 };
 
 }  // namespace vf

@@ -1,0 +1,42 @@
+#pragma once
+
+#include <string>
+
+#include <ros/ros.h>
+
+namespace vf {
+
+/// Full name of the node that owns agent `id` in the namespace of `nh` ("/formation/agent_3").
+std::string agentNodeName(const ros::NodeHandle& nh, int id);
+
+/// Full name of a participant node given relative to the namespace of `nh` (e.g. "monitor").
+std::string participantName(const ros::NodeHandle& nh, const std::string& relative);
+
+/// Whether a message came from the node that owns its topic: the caller id of the message
+/// event, compared with the owner's full node name. ROS 1 has no authentication, so this stops
+/// mistakes and stray tools (a `rostopic pub`, a second formation), not a determined attacker.
+template <class Event>
+bool fromOwner(const Event& event, const std::string& owner) {
+  return event.getPublisherName() == owner;
+}
+
+/// What the master and the node's own XML-RPC port say about a node.
+enum class Liveness { Alive, NotRegistered, NotAnswering };
+
+/**
+ * Asks the master for the node's URI and connects to it (0.5 s at most). A node that was killed
+ * with SIGKILL stays registered, but its port refuses connections: NotAnswering. A stopped
+ * (SIGSTOP) node still accepts connections: Alive. Blocks for at most about a second.
+ */
+Liveness nodeLiveness(const std::string& fullName);
+
+const char* describe(Liveness liveness);
+
+/// Creates the directory that will hold `path` (like mkdir -p). @throws InvalidInput naming
+/// `parameter` when it cannot.
+void createParentDirectory(const std::string& path, const std::string& parameter);
+
+/// Seconds of wall time since `since` (for "waiting for ... for 5.0 s").
+inline double secondsSince(const ros::WallTime& since) { return (ros::WallTime::now() - since).toSec(); }
+
+}  // namespace vf

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Runs formation.launch and tells a good run from a failed one: roslaunch itself exits 0 even
+# when a required node failed, so this reads the result file the monitor writes
+# (output_dir/<name>.result.yaml). Exit status 0 only if the run succeeded (or an unbounded run
+# was stopped); otherwise 1, with the monitor's reason, or roslaunch's own status if no result
+# was written (a bad argument or scenario stops the launch before the monitor runs).
+# usage: run_formation.sh [roslaunch args...] scenario:=S [output_dir:=DIR] [other formation.launch args]
+set -uo pipefail
+scenario=tetrahedron
+output_dir="$HOME/.ros"
+for a in "$@"; do
+  case "$a" in
+    scenario:=*) scenario="${a#scenario:=}" ;;
+    output_dir:=*) output_dir="${a#output_dir:=}" ;;
+  esac
+done
+name="$(basename "$scenario" .yaml)"
+result="$output_dir/$name.result.yaml"
+rm -f "$result"
+roslaunch variational_formation formation.launch "$@"
+status=$?
+if [ ! -f "$result" ]; then
+  echo "run_formation: the run failed before the monitor started (roslaunch exit status $status; see above)" >&2
+  [ "$status" -ne 0 ] && exit "$status" || exit 1
+fi
+outcome="$(sed -n 's/^result: //p' "$result")"
+case "$outcome" in
+  succeeded|stopped) exit 0 ;;
+  *) echo "run_formation: the run $outcome: $(sed -n 's/^reason: //p' "$result" | tr -d '"')" >&2; exit 1 ;;
+esac

@@ -1,0 +1,100 @@
+#include "variational_formation/ros/participants.hpp"
+
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netdb.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <filesystem>
+
+#include <ros/master.h>
+
+#include "variational_formation/core/error.hpp"
+
+namespace vf {
+
+std::string agentNodeName(const ros::NodeHandle& nh, int id) {
+  return participantName(nh, "agent_" + std::to_string(id));
+}
+
+std::string participantName(const ros::NodeHandle& nh, const std::string& relative) {
+  return nh.resolveName(relative, /*remap=*/false);
+}
+
+namespace {
+
+/// host and port of an "http://host:port/" URI.
+bool splitUri(const std::string& uri, std::string& host, int& port) {
+  const std::string scheme = "http://";
+  if (uri.compare(0, scheme.size(), scheme) != 0) return false;
+  const std::string rest = uri.substr(scheme.size());
+  const auto colon = rest.rfind(':');
+  if (colon == std::string::npos) return false;
+  host = rest.substr(0, colon);
+  try {
+    port = std::stoi(rest.substr(colon + 1));
+  } catch (const std::exception&) {
+    return false;
+  }
+  return port > 0 && port < 65536;
+}
+
+/// A TCP connection to host:port succeeds within timeoutMs.
+bool accepts(const std::string& host, int port, int timeoutMs) {
+  addrinfo hints{}, *found = nullptr;
+  hints.ai_socktype = SOCK_STREAM;
+  if (getaddrinfo(host.c_str(), std::to_string(port).c_str(), &hints, &found) != 0 || !found) return false;
+  bool ok = false;
+  for (addrinfo* a = found; a && !ok; a = a->ai_next) {
+    const int fd = socket(a->ai_family, a->ai_socktype | SOCK_NONBLOCK | SOCK_CLOEXEC, a->ai_protocol);
+    if (fd < 0) continue;
+    if (connect(fd, a->ai_addr, a->ai_addrlen) == 0) {
+      ok = true;
+    } else if (errno == EINPROGRESS) {
+      pollfd p{fd, POLLOUT, 0};
+      int error = 0;
+      socklen_t size = sizeof error;
+      ok = poll(&p, 1, timeoutMs) == 1 && getsockopt(fd, SOL_SOCKET, SO_ERROR, &error, &size) == 0 && error == 0;
+    }
+    close(fd);
+  }
+  freeaddrinfo(found);
+  return ok;
+}
+
+}  // namespace
+
+Liveness nodeLiveness(const std::string& fullName) {
+  XmlRpc::XmlRpcValue request, response, payload;
+  request[0] = ros::this_node::getName();
+  request[1] = fullName;
+  if (!ros::master::execute("lookupNode", request, response, payload, false) ||
+      payload.getType() != XmlRpc::XmlRpcValue::TypeString) {
+    return Liveness::NotRegistered;
+  }
+  std::string host;
+  int port = 0;
+  if (!splitUri(static_cast<std::string>(payload), host, port)) return Liveness::NotAnswering;
+  return accepts(host, port, 500) ? Liveness::Alive : Liveness::NotAnswering;
+}
+
+void createParentDirectory(const std::string& path, const std::string& parameter) {
+  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  if (dir.empty()) return;
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error) throw InvalidInput(parameter + ": cannot create the directory '" + dir.string() + "': " + error.message());
+}
+
+const char* describe(Liveness liveness) {
+  switch (liveness) {
+    case Liveness::Alive: return "alive";
+    case Liveness::NotRegistered: return "not registered with the master";
+    case Liveness::NotAnswering: return "registered but its process does not answer (killed?)";
+  }
+  return "?";
+}
+
+}  // namespace vf

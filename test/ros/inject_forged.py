@@ -1,0 +1,52 @@
+#!/usr/bin/python3
+"""A foreign node that forges agent_0's states during a run: well-formed ones (id 0, the step
+agent_0 will publish next, a wrong position), which a check of contents alone would accept, and
+malformed ones (non-finite, wrong dimension, wrong id, impossible steps). Every receiver must drop
+all of them, because they do not come from the node that owns agent_0. It publishes for
+~duration seconds once the run moves, then sets ~published (how many it sent to subscribers)."""
+import math
+
+import rospy
+from variational_formation.msg import AgentState
+
+OWNER = "/formation/agent_0"
+
+
+def main():
+    rospy.init_node("inject_forged")
+    latest = {"step": -1, "d": 2}
+
+    def on_state(msg):
+        if msg._connection_header.get("callerid") == OWNER:
+            latest["step"], latest["d"] = max(latest["step"], msg.step), len(msg.position)
+
+    rospy.Subscriber(OWNER + "/state", AgentState, on_state)
+    pub = rospy.Publisher(OWNER + "/state", AgentState, queue_size=100)
+    while not rospy.is_shutdown() and latest["step"] < 1:
+        rospy.sleep(0.01)
+    published, k = 0, 0
+    end = rospy.get_time() + rospy.get_param("~duration", 3.0)
+    rate = rospy.Rate(50)
+    while not rospy.is_shutdown() and rospy.get_time() < end:
+        d, step = latest["d"], latest["step"] + 1
+        cases = [
+            dict(id=0, step=step, position=[0.5] * d, previous_position=[0.25] * d),  # well-formed
+            dict(id=0, step=step, position=[math.nan] + [0.0] * (d - 1), previous_position=[0.0] * d),
+            dict(id=0, step=step, position=[0.0] * (d + 1), previous_position=[0.0] * (d + 1)),
+            dict(id=7, step=step, position=[0.0] * d, previous_position=[0.0] * d),
+            dict(id=0, step=10 ** 6, position=[0.0] * d, previous_position=[0.0] * d),
+        ]
+        msg = AgentState(**cases[k % len(cases)])
+        msg.header.frame_id = "world"
+        if pub.get_num_connections() > 0:
+            pub.publish(msg)
+            published += 1
+        k += 1
+        rate.sleep()
+    rospy.set_param("~published", published)
+    rospy.loginfo("inject_forged: published %d forged states of agent_0", published)
+    rospy.spin()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,116 @@
+"""Shared by the rostests: the scenario, `simulate`'s trajectory, a recorded bag, and the checks
+every recorded run must pass (every agent's every step, bit for bit equal to simulate, stamps
+equal to the simulated time, the status of every step, the Noether laws)."""
+import csv
+import math
+import os
+import subprocess
+import tempfile
+import time
+
+import rosbag
+import rospkg
+import yaml
+
+PKG = "variational_formation"
+
+
+def scenario_path(name):
+    if "/" in name or name.endswith(".yaml"):
+        return name
+    return os.path.join(rospkg.RosPack().get_path(PKG), "config", name + ".yaml")
+
+
+def load_scenario(path):
+    with open(path) as f:
+        s = yaml.safe_load(f)
+    s["n"] = len(s["agents"])
+    s["neighbours"] = {i: sorted({b for a, b in s["edges"] if a == i} | {a for a, b in s["edges"] if b == i})
+                       for i in range(s["n"])}
+    return s
+
+
+def simulate(path):
+    """{(agent, step): [coordinates]} of `simulate`, as printed (%.17g round-trips a double)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "traj.csv")
+        subprocess.run(["rosrun", PKG, "simulate", "--scenario", path, "--out", out], check=True)
+        with open(out) as f:
+            rows = list(csv.DictReader(f))
+    d = int(load_scenario(path)["dimension"])
+    return {(int(r["agent"]), int(r["step"])): [float(r[c]) for c in "xyz"[:d]] for r in rows}
+
+
+def wait_for_result(path, timeout):
+    """The monitor's result file once the run is over ({} if it is not within `timeout`)."""
+    end = time.time() + timeout
+    while time.time() < end:
+        try:
+            with open(path) as f:
+                result = yaml.safe_load(f) or {}
+            if result.get("result") not in (None, "running"):
+                return result
+        except OSError:
+            pass
+        time.sleep(0.2)
+    return {}
+
+
+class Recording:
+    """Everything a bag of formation.launch record:=true holds, by agent and step."""
+
+    def __init__(self, bag_path, ns="/formation"):
+        self.states, self.status, self.tf, self.markers, self.topics = {}, {}, {}, 0, set()
+        self.bag_times = []
+        with rosbag.Bag(bag_path) as bag:
+            for topic, msg, t in bag.read_messages():
+                self.topics.add(topic)
+                if topic.startswith(ns + "/agent_") and topic.endswith("/state"):
+                    self.states.setdefault((msg.id, msg.step), []).append(msg)
+                    self.bag_times.append((t, msg.header.stamp))
+                elif topic == ns + "/status":
+                    self.status.setdefault(msg.step, []).append(msg)
+                elif topic == ns + "/markers":
+                    self.markers += 1
+                elif topic == "/tf":
+                    for x in msg.transforms:
+                        self.tf.setdefault(x.child_frame_id, []).append(x)
+
+
+class RunChecks:
+    """Mix-in for unittest.TestCase: the checks of one recorded run."""
+
+    def check_recording(self, rec, scenario, expected, ns="/formation"):
+        n, steps, h = scenario["n"], int(scenario["steps"]), float(scenario["time_step"])
+        # Every (agent, step) is there; a repeat (none expected here) would have to be identical.
+        missing = [(i, k) for i in range(n) for k in range(steps + 1) if (i, k) not in rec.states]
+        self.assertEqual(missing[:10], [], f"{len(missing)} agent states missing")
+        self.assertEqual(len(rec.states), n * (steps + 1), "states beyond the last step")
+        mismatches = 0
+        for (i, k), msgs in rec.states.items():
+            for m in msgs:
+                if list(m.position) != expected[(i, k)]:
+                    mismatches += 1
+                # The stamp is the simulated time t_k, to the nanosecond.
+                self.assertLess(abs(m.header.stamp.to_sec() - k * h), 1.01e-9 + 1e-15 * k * h)
+                self.assertAlmostEqual(m.time, k * h, delta=1e-12 * (1 + k * h))
+        self.assertEqual(mismatches, 0, f"{mismatches} recorded positions differ from simulate")
+        self.assertEqual(sorted(rec.status), list(range(steps + 1)), "status of every step once")
+        self.assertEqual(rec.markers, steps + 1)
+        # tf: every agent's frame, prefixed by the namespace, at every step, stamped t_k.
+        prefix = ns.lstrip("/") + "/" if ns.strip("/") else ""
+        for i in range(n):
+            frames = rec.tf.get(f"{prefix}agent_{i}", [])
+            self.assertEqual(len(frames), steps + 1, f"tf of {prefix}agent_{i}")
+            for k, t in enumerate(frames):
+                self.assertEqual(t.header.frame_id, "world")
+                self.assertEqual(t.transform.translation.x, expected[(i, k)][0])
+        self.check_noether(rec)
+
+    def check_noether(self, rec):
+        for k, (s,) in rec.status.items():
+            for x, pred in ((s.linear_momentum, s.linear_momentum_predicted),
+                            (s.angular_momentum, s.angular_momentum_predicted)):
+                scale = max(1.0, math.sqrt(pred.x ** 2 + pred.y ** 2 + pred.z ** 2))
+                err = math.sqrt((x.x - pred.x) ** 2 + (x.y - pred.y) ** 2 + (x.z - pred.z) ** 2)
+                self.assertLess(err / scale, 1e-9, f"step {k}")
