@@ -58,7 +58,6 @@ class RoaCampaign {
   RoaCampaign(const Scenario& scenario, const RoaGrid& grid, const RoaSettings& settings);
 
   int cellCount() const { return grid_.nx * grid_.ny; }
-  const RoaGrid& grid() const { return grid_; }
   const Formation& formation() const { return formation_; }
 
   /// Runs every cell on `threads` threads (results do not depend on the thread count).
