@@ -9,6 +9,7 @@ add_library(variational_formation_core
   src/core/metrics.cpp
   src/core/stability.cpp
   src/core/scenario.cpp
+  src/core/validation.cpp
   src/core/simulation.cpp
   src/core/lockstep_agent.cpp
   src/core/monitor.cpp

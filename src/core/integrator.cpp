@@ -1,9 +1,8 @@
 #include "variational_formation/core/integrator.hpp"
 
-#include <cmath>
-
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/explicit_integrators.hpp"
+#include "variational_formation/core/validation.hpp"
 #include "variational_formation/core/variational_integrator.hpp"
 
 namespace vf {
@@ -40,12 +39,7 @@ std::unique_ptr<Integrator> makeIntegrator(Method method, const Formation& forma
   if (v0.rows() != d || v0.cols() != n) throw InvalidInput("initial_velocity: wrong size");
   if (!q0.allFinite()) throw InvalidInput("initial_position: values must be finite");
   if (!v0.allFinite()) throw InvalidInput("initial_velocity: values must be finite");
-  if (!(std::isfinite(timeStep) && timeStep > 0.0)) {
-    throw InvalidInput("time_step: must be finite and > 0");
-  }
-  if (!(std::isfinite(dampingGain) && dampingGain >= 0.0)) {
-    throw InvalidInput("kappa: must be finite and >= 0");
-  }
+  validateDynamics(timeStep, dampingGain);
   switch (method) {
     case Method::Variational:
       return std::make_unique<VariationalIntegrator>(formation, q0, v0, timeStep, dampingGain,

@@ -7,13 +7,10 @@
 #include <thread>
 
 #include "variational_formation/core/error.hpp"
+#include "variational_formation/core/validation.hpp"
 #include "variational_formation/core/variational_integrator.hpp"
 
 namespace vf {
-
-namespace {
-constexpr int L = RoaCampaign::kLanes;
-}  // namespace
 
 RoaCampaign::RoaCampaign(const Scenario& scenario, const RoaGrid& grid, const RoaSettings& settings)
     : formation_(makeFormation(scenario)),
@@ -34,13 +31,10 @@ RoaCampaign::RoaCampaign(const Scenario& scenario, const RoaGrid& grid, const Ro
   }
   if (grid.xMin > grid.xMax) throw InvalidInput("--x-range: A must be <= B");
   if (grid.yMin > grid.yMax) throw InvalidInput("--y-range: C must be <= D");
-  if (!(std::isfinite(settings.timeStep) && settings.timeStep > 0.0)) {
-    throw InvalidInput("--time-step: must be finite and > 0");
-  }
-  if (!(std::isfinite(settings.dampingGain) && settings.dampingGain >= 0.0)) {
-    throw InvalidInput("--kappa: must be finite and >= 0");
-  }
-  if (settings.steps < 1) throw InvalidInput("--steps: must be >= 1");
+  // The same checks as a scenario's, under the names of the roa flags that set these values.
+  const FieldNames flags{"--kappa", "--time-step", "--steps"};
+  validateDynamics(settings.timeStep, settings.dampingGain, flags);
+  validateSteps(settings.steps, /*requireBounded=*/true, flags.steps);
   if (!(settings.tolerance > 0.0 && std::isfinite(settings.tolerance))) {
     throw InvalidInput("--tolerance: must be finite and > 0");
   }
@@ -113,162 +107,213 @@ Positions RoaCampaign::finalPositionsOfCell(int cell) const {
   return vi.positions();
 }
 
-// The batched kernel: kLanes simulations in structure-of-arrays form, x[(i d + a) L + lane].
-// Per lane it performs the operations of VariationalIntegrator::step in the same order: the
-// gradient is scattered edge by edge (agent j's terms arrive in the order of its neighbour
-// list, and gamma (q_j - q_i) = -(gamma (q_i - q_j)) exactly), then the explicit update.
+namespace {
+
+constexpr int kLanes = RoaCampaign::kLanes;
+
+// kLanes simulations side by side in structure-of-arrays form: coordinate a of agent i in lane l
+// is at [(i d + a) kLanes + l], so that every inner loop runs over the lanes.
+struct LaneState {
+  LaneState(int agents, int dimension)
+      : agents(agents), dimension(dimension), stride(agents * dimension * kLanes),
+        buffer(4 * static_cast<std::size_t>(stride), 0.0) {
+    qPrev = buffer.data();
+    q = qPrev + stride;
+    qNext = q + stride;
+    gradient = qNext + stride;
+    for (int l = 0; l < kLanes; ++l) {
+      lastIncongruent[l] = -1;
+      diverged[l] = false;
+      congruent[l] = false;
+    }
+  }
+
+  int agents, dimension;
+  int stride;                  // doubles per set of positions
+  std::vector<double> buffer;  // the four sets below
+  double* qPrev;               // q_{k-1}
+  double* q;                   // q_k
+  double* qNext;               // q_{k+1}, being computed
+  double* gradient;            // grad V(q_k)
+  long lastIncongruent[kLanes];
+  bool diverged[kLanes];
+  bool congruent[kLanes];
+};
+
+// gradient = grad V(q_k), scattered edge by edge as Formation::agentGradient gathers it: agent
+// j's terms arrive in the order of its neighbour list, and gamma (q_j - q_i) = -(gamma (q_i - q_j))
+// exactly.
+void accumulateGradient(const std::vector<Edge>& edges, LaneState& s) {
+  const int d = s.dimension;
+  double* const g = s.gradient;
+  const double* const q = s.q;
+  std::fill(g, g + s.stride, 0.0);
+  for (const Edge& e : edges) {
+    double* gi = g + e.tail * d * kLanes;
+    double* gj = g + e.head * d * kLanes;
+    const double* qi = q + e.tail * d * kLanes;
+    const double* qj = q + e.head * d * kLanes;
+    double gamma[kLanes];
+    for (int l = 0; l < kLanes; ++l) gamma[l] = 0.0;
+    for (int a = 0; a < d; ++a) {
+      for (int l = 0; l < kLanes; ++l) {
+        const double diff = qi[a * kLanes + l] - qj[a * kLanes + l];
+        gamma[l] += diff * diff;
+      }
+    }
+    for (int l = 0; l < kLanes; ++l) gamma[l] -= e.desiredDistanceSquared;
+    for (int a = 0; a < d; ++a) {
+      for (int l = 0; l < kLanes; ++l) {
+        const double term = gamma[l] * (qi[a * kLanes + l] - qj[a * kLanes + l]);
+        gi[a * kLanes + l] += term;
+        gj[a * kLanes + l] -= term;
+      }
+    }
+  }
+}
+
+// q_{k+1} from q_k (and q_{k-1}) with the operations of variationalStart (k = 0, v_0 = 0) and
+// variationalUpdate, then shifts the window so that q holds step k + 1.
+void advance(const VariationalCoefficients& c, long k, LaneState& s) {
+  const double* const qPrev = s.qPrev;
+  const double* const q = s.q;
+  const double* const g = s.gradient;
+  double* const qNext = s.qNext;
+  if (k == 0) {
+    for (int x = 0; x < s.stride; ++x) {
+      qNext[x] = q[x] + c.startGain * (0.0 - 0.5 * c.timeStep * g[x]);
+    }
+  } else {
+    for (int x = 0; x < s.stride; ++x) {
+      qNext[x] = c.positionGain * q[x] - c.decay * qPrev[x] - c.gradientGain * g[x];
+    }
+  }
+  std::swap(s.qPrev, s.q);
+  std::swap(s.q, s.qNext);
+}
+
+// Marks lanes with a coordinate beyond `bound` (or NaN) at the current step; true once every
+// lane has diverged.
+bool markDiverged(double bound, LaneState& s) {
+  bool allDiverged = true;
+  for (int l = 0; l < kLanes; ++l) {
+    if (s.diverged[l]) continue;
+    for (int x = l; x < s.stride; x += kLanes) {
+      if (!(std::abs(s.q[x]) <= bound)) {
+        s.diverged[l] = true;
+        break;
+      }
+    }
+    allDiverged = allDiverged && s.diverged[l];
+  }
+  return allDiverged;
+}
+
+// Congruence at step k as Formation::isCongruent tests it, v_k = (q_k - q_{k-1})/h: every speed
+// below maxSpeed and every pair distance within tolerance of the desired one.
+void markCongruent(long k, double h, double tolerance, double maxSpeed,
+                   const std::vector<double>& desiredPairDistance, LaneState& s) {
+  const int n = s.agents, d = s.dimension;
+  const double* const q = s.q;
+  const double* const qPrev = s.qPrev;
+  double ok[kLanes];
+  for (int l = 0; l < kLanes; ++l) ok[l] = 1.0;
+  for (int i = 0; i < n; ++i) {
+    double speed2[kLanes];
+    for (int l = 0; l < kLanes; ++l) speed2[l] = 0.0;
+    for (int a = 0; a < d; ++a) {
+      for (int l = 0; l < kLanes; ++l) {
+        const int x = (i * d + a) * kLanes + l;
+        const double v = (q[x] - qPrev[x]) / h;
+        speed2[l] += v * v;
+      }
+    }
+    for (int l = 0; l < kLanes; ++l) ok[l] = std::sqrt(speed2[l]) < maxSpeed ? ok[l] : 0.0;
+  }
+  // The O(n^2) pair test only matters for lanes that pass the O(n) speed test.
+  bool anySlow = false;
+  for (int l = 0; l < kLanes; ++l) anySlow = anySlow || ok[l] != 0.0;
+  int pair = 0;
+  for (int i = 0; i < n && anySlow; ++i) {
+    for (int j = i + 1; j < n; ++j, ++pair) {
+      const double desired = desiredPairDistance[pair];
+      double dist2[kLanes];
+      for (int l = 0; l < kLanes; ++l) dist2[l] = 0.0;
+      for (int a = 0; a < d; ++a) {
+        for (int l = 0; l < kLanes; ++l) {
+          const double diff = q[(i * d + a) * kLanes + l] - q[(j * d + a) * kLanes + l];
+          dist2[l] += diff * diff;
+        }
+      }
+      for (int l = 0; l < kLanes; ++l) {
+        ok[l] = std::abs(std::sqrt(dist2[l]) - desired) <= tolerance * desired ? ok[l] : 0.0;
+      }
+    }
+  }
+  for (int l = 0; l < kLanes; ++l) {
+    s.congruent[l] = ok[l] != 0.0;
+    if (!s.congruent[l]) s.lastIncongruent[l] = k;
+  }
+}
+
+// Starts lane l at rest at q0 (d x n): q_{-1} = q_0.
+void setLane(const Positions& q0, int l, LaneState& s) {
+  for (int i = 0; i < s.agents; ++i) {
+    for (int a = 0; a < s.dimension; ++a) {
+      const int x = (i * s.dimension + a) * kLanes + l;
+      s.q[x] = s.qPrev[x] = q0(a, i);
+    }
+  }
+}
+
+// Lane l's current positions as d x n.
+Positions lanePositions(const LaneState& s, int l) {
+  Positions p(s.dimension, s.agents);
+  for (int i = 0; i < s.agents; ++i)
+    for (int a = 0; a < s.dimension; ++a) p(a, i) = s.q[(i * s.dimension + a) * kLanes + l];
+  return p;
+}
+
+}  // namespace
+
+// The batched kernel: per lane, the operations of VariationalIntegrator::step and the
+// congruence test of simulateCell, in the same order, so the positions are bit-identical.
 void RoaCampaign::simulateBatch(int first, int count, RoaCell* out,
                                 std::vector<Positions>* finalPositions) const {
-  const int n = formation_.agentCount();
-  const int d = formation_.dimension();
-  const int stride = n * d * L;
-  std::vector<double> buffer(4 * static_cast<std::size_t>(stride), 0.0);
-  double* qPrev = buffer.data();
-  double* q = qPrev + stride;
-  double* qNext = q + stride;
-  double* g = qNext + stride;
-  std::vector<Positions> starts;
-  for (int l = 0; l < L; ++l) {
-    // Idle lanes repeat the first cell so that they stay finite.
-    const Positions q0 = initialPositions(first + std::min(l, count - 1));
-    for (int i = 0; i < n; ++i)
-      for (int a = 0; a < d; ++a) q[(i * d + a) * L + l] = q0(a, i);
+  LaneState lanes(formation_.agentCount(), formation_.dimension());
+  for (int l = 0; l < kLanes; ++l) {
+    // Idle lanes repeat the batch's last cell so that they stay finite.
+    setLane(initialPositions(first + std::min(l, count - 1)), l, lanes);
   }
-  std::copy(q, q + stride, qPrev);
-
-  const auto& edges = formation_.edges();
-  const VariationalCoefficients& c = coefficients_;
-  const double h = settings_.timeStep;
-  const double tol = settings_.tolerance;
-  const double maxSpeed = settings_.maxSpeed;
-  const double bound = settings_.divergenceBound;
-
-  long lastIncongruent[L];
-  bool diverged[L];
-  bool congruent[L];
-  for (int l = 0; l < L; ++l) {
-    lastIncongruent[l] = -1;
-    diverged[l] = false;
-    congruent[l] = false;
-  }
-
   for (long k = 0; k <= settings_.steps; ++k) {
     if (k > 0) {
-      std::fill(g, g + stride, 0.0);
-      for (const Edge& e : edges) {
-        double* gi = g + e.tail * d * L;
-        double* gj = g + e.head * d * L;
-        const double* qi = q + e.tail * d * L;
-        const double* qj = q + e.head * d * L;
-        double gamma[L];
-        for (int l = 0; l < L; ++l) gamma[l] = 0.0;
-        for (int a = 0; a < d; ++a) {
-          for (int l = 0; l < L; ++l) {
-            const double diff = qi[a * L + l] - qj[a * L + l];
-            gamma[l] += diff * diff;
-          }
-        }
-        for (int l = 0; l < L; ++l) gamma[l] -= e.desiredDistanceSquared;
-        for (int a = 0; a < d; ++a) {
-          for (int l = 0; l < L; ++l) {
-            const double term = gamma[l] * (qi[a * L + l] - qj[a * L + l]);
-            gi[a * L + l] += term;
-            gj[a * L + l] -= term;
-          }
-        }
-      }
-      if (k == 1) {
-        // Variational start with v_0 = 0 (variationalStart).
-        for (int x = 0; x < stride; ++x) {
-          qNext[x] = q[x] + c.startGain * (0.0 - 0.5 * c.timeStep * g[x]);
-        }
-      } else {
-        // DESIGN.md §1 explicit update (variationalUpdate).
-        for (int x = 0; x < stride; ++x) {
-          qNext[x] = c.positionGain * q[x] - c.decay * qPrev[x] - c.gradientGain * g[x];
-        }
-      }
-      std::swap(qPrev, q);
-      std::swap(q, qNext);
+      accumulateGradient(formation_.edges(), lanes);
+      advance(coefficients_, k - 1, lanes);
     }
-    // Divergence and congruence at step k, v_k = (q_k - q_{k-1})/h (v_0 = 0).
-    bool allDiverged = true;
-    for (int l = 0; l < L; ++l) {
-      if (diverged[l]) continue;
-      for (int x = l; x < stride; x += L) {
-        if (!(std::abs(q[x]) <= bound)) {
-          diverged[l] = true;
-          break;
-        }
-      }
-      allDiverged = allDiverged && diverged[l];
-    }
-    if (allDiverged) break;
-    double ok[L];
-    for (int l = 0; l < L; ++l) ok[l] = 1.0;
-    for (int i = 0; i < n; ++i) {
-      double speed2[L];
-      for (int l = 0; l < L; ++l) speed2[l] = 0.0;
-      for (int a = 0; a < d; ++a) {
-        for (int l = 0; l < L; ++l) {
-          const int x = (i * d + a) * L + l;
-          const double v = (q[x] - qPrev[x]) / h;
-          speed2[l] += v * v;
-        }
-      }
-      for (int l = 0; l < L; ++l) ok[l] = std::sqrt(speed2[l]) < maxSpeed ? ok[l] : 0.0;
-    }
-    // The O(n^2) pair test only matters for lanes that pass the O(n) speed test.
-    bool anySlow = false;
-    for (int l = 0; l < L; ++l) anySlow = anySlow || ok[l] != 0.0;
-    int pair = 0;
-    for (int i = 0; i < n && anySlow; ++i) {
-      for (int j = i + 1; j < n; ++j, ++pair) {
-        const double desired = desiredPairDistance_[pair];
-        double dist2[L];
-        for (int l = 0; l < L; ++l) dist2[l] = 0.0;
-        for (int a = 0; a < d; ++a) {
-          for (int l = 0; l < L; ++l) {
-            const double diff = q[(i * d + a) * L + l] - q[(j * d + a) * L + l];
-            dist2[l] += diff * diff;
-          }
-        }
-        for (int l = 0; l < L; ++l) {
-          ok[l] = std::abs(std::sqrt(dist2[l]) - desired) <= tol * desired ? ok[l] : 0.0;
-        }
-      }
-    }
-    for (int l = 0; l < L; ++l) {
-      congruent[l] = ok[l] != 0.0;
-      if (!congruent[l]) lastIncongruent[l] = k;
-    }
+    if (markDiverged(settings_.divergenceBound, lanes)) break;
+    markCongruent(k, settings_.timeStep, settings_.tolerance, settings_.maxSpeed,
+                  desiredPairDistance_, lanes);
   }
-
   for (int l = 0; l < count; ++l) {
     RoaCell cell = cellAt(first + l);
-    cell.diverged = diverged[l];
-    cell.converged = !diverged[l] && congruent[l];
-    cell.convergedStep = cell.converged ? lastIncongruent[l] + 1 : -1;
+    cell.diverged = lanes.diverged[l];
+    cell.converged = !lanes.diverged[l] && lanes.congruent[l];
+    cell.convergedStep = cell.converged ? lanes.lastIncongruent[l] + 1 : -1;
     out[l] = cell;
-    if (finalPositions) {
-      Positions p(d, n);
-      for (int i = 0; i < n; ++i)
-        for (int a = 0; a < d; ++a) p(a, i) = q[(i * d + a) * L + l];
-      finalPositions->push_back(p);
-    }
+    if (finalPositions) finalPositions->push_back(lanePositions(lanes, l));
   }
 }
 
 std::vector<RoaCell> RoaCampaign::run(int threads, const std::function<void(long)>& progress) const {
   const int cells = cellCount();
   std::vector<RoaCell> results(static_cast<std::size_t>(cells));
-  const int batches = (cells + L - 1) / L;
+  const int batches = (cells + kLanes - 1) / kLanes;
   std::atomic<int> next{0};
   std::atomic<long> done{0};
   const auto worker = [&] {
     for (int b = next++; b < batches; b = next++) {
-      const int first = b * L;
-      const int count = std::min(L, cells - first);
+      const int first = b * kLanes;
+      const int count = std::min(kLanes, cells - first);
       simulateBatch(first, count, &results[static_cast<std::size_t>(first)]);
       done += count;
     }

@@ -10,7 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "variational_formation/core/error.hpp"
-#include "variational_formation/core/stability.hpp"
+#include "variational_formation/core/validation.hpp"
 
 namespace vf {
 
@@ -142,35 +142,6 @@ Scenario parseRoot(const YAML::Node& root) {
 }
 
 }  // namespace
-
-void validateScenario(Scenario& s, bool requireBoundedSteps) {
-  if (!(std::isfinite(s.dampingGain) && s.dampingGain >= 0.0)) {
-    std::ostringstream msg;
-    msg << "kappa: must be finite and >= 0, got " << s.dampingGain;
-    throw InvalidInput(msg.str());
-  }
-  if (!(std::isfinite(s.timeStep) && s.timeStep > 0.0)) {
-    std::ostringstream msg;
-    msg << "time_step: must be finite and > 0, got " << s.timeStep;
-    throw InvalidInput(msg.str());
-  }
-  if (s.steps < 0) throw InvalidInput("steps: must be >= 0, got " + std::to_string(s.steps));
-  if (requireBoundedSteps && s.steps == 0) {
-    throw InvalidInput("steps: must be >= 1 here (0 = unbounded is only for the ROS run)");
-  }
-  // Formation's constructor checks the edges and the desired shape.
-  const Formation formation = makeFormation(s);
-  s.warnings.clear();
-  if (s.agentCount() >= 2 && !formation.isInfinitesimallyRigid(s.desiredPositions)) {
-    s.warnings.push_back("edges: the desired graph is not infinitesimally rigid (rank " +
-                         std::to_string(formation.rigidityRank(s.desiredPositions)) + ", need " +
-                         std::to_string(rigidEdgeCount(s.dimension, s.agentCount())) +
-                         "): the shape is not determined by its edge lengths");
-  }
-  const StepSizeAdvice advice =
-      adviseTimeStep(formation, s.initialPositions, s.timeStep, s.dampingGain);
-  if (advice.exceeded) s.warnings.push_back(advice.message);
-}
 
 Scenario parseScenario(const std::string& yamlText, const std::string& source) {
   try {

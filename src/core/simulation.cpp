@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <ostream>
 
-#include "variational_formation/core/error.hpp"
+#include "variational_formation/core/validation.hpp"
 #include "variational_formation/core/metrics.hpp"
 
 namespace vf {
@@ -22,9 +22,7 @@ StepMetrics measure(const Integrator& integrator) {
 
 void runScenario(const Scenario& scenario, Method method, StartMethod start,
                  const std::function<void(const Integrator&)>& observe) {
-  if (scenario.steps <= 0) {
-    throw InvalidInput("steps: must be >= 1 for a centralised run (0 = unbounded is only for the ROS run)");
-  }
+  validateSteps(scenario.steps, /*requireBounded=*/true);
   const Formation formation = makeFormation(scenario);
   auto integrator = makeIntegrator(method, formation, scenario.initialPositions,
                                    scenario.initialVelocities, scenario.timeStep,

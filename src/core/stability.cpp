@@ -47,7 +47,7 @@ double stableTimeStepLimit(double frequency, double dampingGain) {
 }
 
 StepSizeAdvice adviseTimeStep(const Formation& formation, const Positions& q0, double timeStep,
-                              double dampingGain) {
+                              double dampingGain, const std::string& field) {
   StepSizeAdvice advice{};
   advice.frequency = std::max(maxStiffnessFrequency(formation, q0),
                               maxStiffnessFrequency(formation, formation.desiredShape()));
@@ -56,7 +56,7 @@ StepSizeAdvice adviseTimeStep(const Formation& formation, const Positions& q0, d
   if (advice.exceeded) {
     std::ostringstream msg;
     msg.precision(4);
-    msg << "time_step: h = " << timeStep << " exceeds the linear stability limit "
+    msg << field << ": h = " << timeStep << " exceeds the linear stability limit "
         << advice.limit << " s (largest Hessian frequency w = " << advice.frequency
         << " 1/s; stable iff h w < 2 cosh(kappa h / 2))";
     advice.message = msg.str();

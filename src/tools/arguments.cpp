@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 
 #include "variational_formation/core/error.hpp"
 
@@ -72,6 +73,17 @@ long Arguments::integer(const std::string& flag, long min, long max, int i) cons
                        std::to_string(max) + ", got " + s);
   }
   return v;
+}
+
+ScenarioOverrides scenarioOverrides(const Arguments& args) {
+  ScenarioOverrides overrides;
+  if (args.has("--time-step")) overrides.timeStep = args.number("--time-step");
+  if (args.has("--kappa")) overrides.dampingGain = args.number("--kappa");
+  if (args.has("--steps")) {
+    overrides.steps = args.integer("--steps", std::numeric_limits<long>::min(),
+                                   std::numeric_limits<long>::max());
+  }
+  return overrides;
 }
 
 }  // namespace vf

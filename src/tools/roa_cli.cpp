@@ -4,9 +4,10 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
-#include <limits>
 #include <ostream>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/roa.hpp"
@@ -23,7 +24,8 @@ const char* kUsage =
     "           [--tolerance 0.01] [--speed 0.1] [--threads T] --out roa.csv\n"
     "Region of attraction (paper Section 6.2): for every grid point, agent I starts there at\n"
     "rest and the others at rest at their desired positions. roa.csv:\n"
-    "ix,iy,x,y,converged,converged_step,diverged. Exit status 2 on bad input.\n";
+    "ix,iy,x,y,converged,converged_step,diverged. --time-step, --steps and --kappa override\n"
+    "the scenario and are checked like it. Exit status 2 on bad input.\n";
 
 void drawBar(std::ostream& err, long done, long total) {
   const int width = 40;
@@ -31,6 +33,82 @@ void drawBar(std::ostream& err, long done, long total) {
   err << "\r[" << std::string(static_cast<std::size_t>(filled), '#')
       << std::string(static_cast<std::size_t>(width - filled), ' ') << "] " << done << '/'
       << total << std::flush;
+}
+
+// --agent, --x-range, --y-range, --z (3D: default the agent's desired z), --resolution.
+RoaGrid readGrid(const Arguments& args, const Scenario& scenario) {
+  RoaGrid grid;
+  grid.agent = static_cast<int>(args.integer("--agent", 0, scenario.agentCount() - 1));
+  grid.xMin = args.number("--x-range", 0);
+  grid.xMax = args.number("--x-range", 1);
+  grid.yMin = args.number("--y-range", 0);
+  grid.yMax = args.number("--y-range", 1);
+  if (args.has("--z")) {
+    if (scenario.dimension != 3) throw InvalidInput("--z: only for 3D scenarios");
+    grid.z = args.number("--z");
+  } else if (scenario.dimension == 3) {
+    grid.z = scenario.desiredPositions(2, grid.agent);
+  }
+  grid.nx = static_cast<int>(args.integer("--resolution", 1, 100000, 0));
+  grid.ny = static_cast<int>(args.integer("--resolution", 1, 100000, 1));
+  return grid;
+}
+
+// h, kappa and steps of the scenario (its overrides applied and validated), --tolerance, --speed.
+RoaSettings readSettings(const Arguments& args, const Scenario& scenario) {
+  RoaSettings settings;
+  settings.timeStep = scenario.timeStep;
+  settings.dampingGain = scenario.dampingGain;
+  settings.steps = scenario.steps;
+  if (args.has("--tolerance")) settings.tolerance = args.positiveNumber("--tolerance");
+  if (args.has("--speed")) settings.maxSpeed = args.positiveNumber("--speed");
+  return settings;
+}
+
+int readThreads(const Arguments& args) {
+  const int hardware = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  return args.has("--threads") ? static_cast<int>(args.integer("--threads", 1, 1024)) : hardware;
+}
+
+// Runs the campaign (with a progress bar on a terminal); returns the cells and the seconds taken.
+std::vector<RoaCell> runTimed(const RoaCampaign& campaign, int threads, std::ostream& err,
+                              bool progressToTerminal, double& seconds) {
+  const auto start = std::chrono::steady_clock::now();
+  std::function<void(long)> progress;
+  if (progressToTerminal) {
+    progress = [&](long done) { drawBar(err, done, campaign.cellCount()); };
+  }
+  std::vector<RoaCell> cells = campaign.run(threads, progress);
+  seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (progressToTerminal) err << '\n';
+  return cells;
+}
+
+// roa.csv rows, 17 significant digits.
+void writeCells(std::ostream& csv, const std::vector<RoaCell>& cells) {
+  csv << "ix,iy,x,y,converged,converged_step,diverged\n";
+  char line[160];
+  for (const RoaCell& c : cells) {
+    std::snprintf(line, sizeof line, "%d,%d,%.17g,%.17g,%d,%ld,%d\n", c.ix, c.iy, c.x, c.y,
+                  c.converged ? 1 : 0, c.convergedStep, c.diverged ? 1 : 0);
+    csv << line;
+  }
+}
+
+std::string summary(const std::vector<RoaCell>& cells, double seconds, int threads, long steps) {
+  long converged = 0, diverged = 0;
+  for (const RoaCell& c : cells) {
+    converged += c.converged;
+    diverged += c.diverged;
+  }
+  const double total = static_cast<double>(cells.size());
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "roa: %zu cells, converged %.1f%%, diverged %.1f%%, compute %.1f ms on %d "
+                "threads, %.0f simulations/s (%ld steps each)\n",
+                cells.size(), 100.0 * converged / total, 100.0 * diverged / total, 1e3 * seconds,
+                threads, total / std::max(seconds, 1e-9), steps);
+  return text;
 }
 
 }  // namespace
@@ -51,68 +129,23 @@ int runRoaCli(int argc, const char* const* argv, std::ostream& out, std::ostream
       args.require(flag);
     }
     Scenario scenario = loadScenario(args.text("--scenario"));
-    RoaGrid grid;
-    grid.agent = static_cast<int>(args.integer("--agent", 0, scenario.agentCount() - 1));
-    grid.xMin = args.number("--x-range", 0);
-    grid.xMax = args.number("--x-range", 1);
-    grid.yMin = args.number("--y-range", 0);
-    grid.yMax = args.number("--y-range", 1);
-    if (args.has("--z")) {
-      if (scenario.dimension != 3) throw InvalidInput("--z: only for 3D scenarios");
-      grid.z = args.number("--z");
-    } else if (scenario.dimension == 3) {
-      grid.z = scenario.desiredPositions(2, grid.agent);
-    }
-    grid.nx = static_cast<int>(args.integer("--resolution", 1, 100000, 0));
-    grid.ny = static_cast<int>(args.integer("--resolution", 1, 100000, 1));
-    RoaSettings settings;
-    settings.timeStep = args.has("--time-step") ? args.positiveNumber("--time-step") : scenario.timeStep;
-    settings.dampingGain = args.has("--kappa") ? args.number("--kappa") : scenario.dampingGain;
-    settings.steps = args.has("--steps") ? args.integer("--steps", 1, 100000000) : scenario.steps;
-    if (settings.steps < 1) throw InvalidInput("--steps: the scenario has steps 0 (unbounded); give --steps N");
-    if (args.has("--tolerance")) settings.tolerance = args.positiveNumber("--tolerance");
-    if (args.has("--speed")) settings.maxSpeed = args.positiveNumber("--speed");
-    const int hardware = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-    const int threads =
-        args.has("--threads") ? static_cast<int>(args.integer("--threads", 1, 1024)) : hardware;
-    const RoaCampaign campaign(scenario, grid, settings);
-
+    applyOverrides(scenario, scenarioOverrides(args), /*requireBoundedSteps=*/true);
+    for (const std::string& w : scenario.warnings) err << "roa: warning: " << w << '\n';
+    const RoaCampaign campaign(scenario, readGrid(args, scenario), readSettings(args, scenario));
+    const int threads = readThreads(args);
     std::ofstream csv(args.text("--out"));
     if (!csv) throw InvalidInput("--out: cannot write '" + args.text("--out") + "'");
 
-    const auto start = std::chrono::steady_clock::now();
-    std::function<void(long)> progress;
-    if (progressToTerminal) {
-      progress = [&](long done) { drawBar(err, done, campaign.cellCount()); };
-    }
-    const std::vector<RoaCell> cells = campaign.run(threads, progress);
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (progressToTerminal) err << '\n';
-
-    csv << "ix,iy,x,y,converged,converged_step,diverged\n";
-    long converged = 0, diverged = 0;
-    char line[160];
-    for (const RoaCell& c : cells) {
-      std::snprintf(line, sizeof line, "%d,%d,%.17g,%.17g,%d,%ld,%d\n", c.ix, c.iy, c.x, c.y,
-                    c.converged ? 1 : 0, c.convergedStep, c.diverged ? 1 : 0);
-      csv << line;
-      converged += c.converged;
-      diverged += c.diverged;
-    }
+    double seconds = 0.0;
+    const std::vector<RoaCell> cells = runTimed(campaign, threads, err, progressToTerminal, seconds);
+    writeCells(csv, cells);
     csv.flush();
     if (!csv) {
       err << "roa: error: writing " << args.text("--out") << " failed\n";
       return kExitFailure;
     }
-    const double total = static_cast<double>(cells.size());
-    char summary[256];
-    std::snprintf(summary, sizeof summary,
-                  "roa: %zu cells, converged %.1f%%, diverged %.1f%%, compute %.1f ms on %d "
-                  "threads, %.0f simulations/s (%ld steps each)\n",
-                  cells.size(), 100.0 * converged / total, 100.0 * diverged / total,
-                  1e3 * seconds, threads, total / std::max(seconds, 1e-9), settings.steps);
-    out << summary;
+    // Diverged cells are a result of the campaign, not an error.
+    out << summary(cells, seconds, threads, scenario.steps);
     return kExitOk;
   } catch (const InvalidInput& e) {
     err << "roa: error: " << e.what() << '\n';

@@ -1,16 +1,20 @@
-// `scenario_info --scenario FILE`: validates a scenario through the one loader and prints
-// "agents N" (and its warnings on stderr). Used by the launch files; exit 2 on bad input.
+// `scenario_info --scenario FILE [--real-time-factor R]`: validates a scenario (and a pacing
+// factor) through the one validation path and prints "agents N" (and its warnings on stderr).
+// Used by the launch files; exit 2 on bad input.
 #include <iostream>
 
 #include "variational_formation/core/error.hpp"
-#include "variational_formation/core/scenario.hpp"
+#include "variational_formation/core/validation.hpp"
 #include "variational_formation/tools/arguments.hpp"
 #include "variational_formation/tools/simulate_cli.hpp"
 
 int main(int argc, char** argv) {
   try {
-    const vf::Arguments args(argc, argv, {{"--scenario", 1}});
+    const vf::Arguments args(argc, argv, {{"--scenario", 1}, {"--real-time-factor", 1}});
     const vf::Scenario s = vf::loadScenario(args.text("--scenario"));
+    if (args.has("--real-time-factor")) {
+      vf::validateRealTimeFactor(args.number("--real-time-factor"), s.timeStep, "--real-time-factor");
+    }
     for (const auto& w : s.warnings) std::cerr << "scenario_info: warning: " << w << '\n';
     std::cout << "agents " << s.agentCount() << '\n';
     return vf::kExitOk;

@@ -1,7 +1,6 @@
 #include "variational_formation/tools/simulate_cli.hpp"
 
 #include <fstream>
-#include <limits>
 #include <ostream>
 
 #include "variational_formation/core/error.hpp"
@@ -14,11 +13,11 @@ namespace {
 
 const char* kUsage =
     "usage: simulate --scenario FILE --out traj.csv [--metrics metrics.csv]\n"
-    "                [--method vi|euler|rk4] [--init variational|paper]\n"
+    "                [--method vi|euler|rk4] [--init variational|paper (vi only)]\n"
     "                [--time-step H] [--steps N] [--kappa K]\n"
     "Runs a formation scenario centrally. traj.csv: step,t,agent,x,y,z;\n"
     "metrics.csv: step,t,energy,max_distance_error,px,py,pz,ax,ay,az.\n"
-    "Flags override the scenario file. Exit status 2 on bad input.\n";
+    "Flags override the scenario file. Exit status 2 on bad input, 1 if the run diverges.\n";
 
 std::ofstream openOutput(const std::string& flag, const std::string& path) {
   std::ofstream out(path);
@@ -42,16 +41,12 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
     args.require("--out");
     const Method method = parseMethod(args.text("--method", "vi"));
     const StartMethod start = parseStartMethod(args.text("--init", "variational"));
+    if (args.has("--init") && method != Method::Variational) {
+      throw InvalidInput("--init: only for --method vi (euler and rk4 start from v_0 directly), got --method " +
+                         args.text("--method"));
+    }
     Scenario scenario = loadScenario(args.text("--scenario"));
-    if (args.has("--time-step")) scenario.timeStep = args.positiveNumber("--time-step");
-    if (args.has("--steps")) {
-      scenario.steps = args.integer("--steps", 1, std::numeric_limits<long>::max() / 2);
-    }
-    if (args.has("--kappa")) {
-      scenario.dampingGain = args.number("--kappa");
-      if (scenario.dampingGain < 0.0) throw InvalidInput("--kappa: must be >= 0");
-    }
-    validateScenario(scenario, /*requireBoundedSteps=*/true);
+    applyOverrides(scenario, scenarioOverrides(args), /*requireBoundedSteps=*/true);
     for (const std::string& w : scenario.warnings) err << "simulate: warning: " << w << '\n';
 
     std::ofstream traj = openOutput("--out", args.text("--out"));
@@ -76,8 +71,9 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
       return kExitFailure;
     }
     if (divergedAt >= 0) {
-      err << "simulate: warning: the run diverged (non-finite positions from step " << divergedAt
-          << "); try a smaller --time-step\n";
+      err << "simulate: error: the run diverged: non-finite positions from step " << divergedAt
+          << " (try a smaller --time-step)\n";
+      return kExitFailure;
     }
     return kExitOk;
   } catch (const InvalidInput& e) {

@@ -1,10 +1,17 @@
-// Scenario loading: one test per validation rule; every error names its field.
+// Scenario loading and the one validation path: one test per rule; every error names its field,
+// the value and the limit; the boundary values are accepted.
 #include <gtest/gtest.h>
 
+#include <cfloat>
+#include <cmath>
+#include <cstdint>
+#include <functional>
 #include <string>
 
 #include "test_support.hpp"
 #include "variational_formation/core/error.hpp"
+#include "variational_formation/core/validation.hpp"
+#include "variational_formation/core/variational_update.hpp"
 
 namespace vf {
 namespace {
@@ -126,7 +133,7 @@ TEST(Scenario, TimeStepMustBePositive) {
   expectError(replaced(valid(), "time_step: 0.01", "time_step: -0.1"), {"time_step", "> 0"});
 }
 TEST(Scenario, StepsNonNegative) {
-  expectError(replaced(valid(), "steps: 10", "steps: -1"), {"steps", ">= 0"});
+  expectError(replaced(valid(), "steps: 10", "steps: -1"), {"steps: must be between 0 and", "got -1"});
   Scenario s = parseScenario(replaced(valid(), "steps: 10", "steps: 0"), "file.yaml");
   EXPECT_EQ(s.steps, 0);  // unbounded: accepted for the ROS run
   EXPECT_THROW(validateScenario(s, /*requireBoundedSteps=*/true), InvalidInput);
@@ -149,6 +156,168 @@ TEST(Scenario, LargeTimeStepIsAcceptedWithAWarning) {
       replaced(replaced(valid(), "time_step: 0.01", "time_step: 2.0"), "kappa: 1.0", "kappa: 0"), "file.yaml");
   ASSERT_EQ(s.warnings.size(), 1u);
   EXPECT_NE(s.warnings[0].find("stability limit"), std::string::npos);
+}
+
+
+// --- The limits of README "Limits": each rejected value and the boundary still accepted. ---
+
+double up(double x) { return std::nextafter(x, HUGE_VAL); }
+double down(double x) { return std::nextafter(x, 0.0); }
+
+// Expects `check` to throw InvalidInput, one line, containing every fragment.
+void expectRejected(const std::function<void()>& check, std::initializer_list<std::string> fragments) {
+  try {
+    check();
+    ADD_FAILURE() << "accepted: " << *fragments.begin();
+  } catch (const InvalidInput& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    for (const auto& f : fragments) EXPECT_NE(what.find(f), std::string::npos) << what << " / " << f;
+  }
+}
+
+void expectDynamicsRejected(double h, double kappa, std::initializer_list<std::string> fragments) {
+  expectRejected([&] { validateDynamics(h, kappa); }, fragments);
+}
+
+// The gains the update multiplies by, all normal doubles at an accepted (h, kappa).
+void expectNormalGains(double h, double kappa) {
+  EXPECT_NO_THROW(validateDynamics(h, kappa)) << "h " << h << " kappa " << kappa;
+  const VariationalCoefficients c(h, kappa);
+  for (double gain : {c.decay, c.positionGain, c.gradientGain, c.startGain}) {
+    EXPECT_TRUE(std::isnormal(gain)) << gain << " at h " << h << " kappa " << kappa;
+  }
+}
+
+TEST(Limits, ConstantsAreTheBoundariesOfDoubleArithmetic) {
+  // Each constant against its definition, from <cfloat> and <cstdint> (not from the code).
+  EXPECT_TRUE(std::isfinite(2.0 * limits::kMaxTimeStep * limits::kMaxTimeStep));
+  EXPECT_FALSE(std::isfinite(2.0 * up(limits::kMaxTimeStep) * up(limits::kMaxTimeStep)));
+  EXPECT_GE(std::exp(-limits::kMaxDampingTimeStep), DBL_MIN);
+  EXPECT_LT(std::exp(-up(limits::kMaxDampingTimeStep)), DBL_MIN);
+  EXPECT_LT(limits::kMaxDampingTimeStep, std::log(DBL_MAX));  // so e^{kappa h} is finite too
+  EXPECT_EQ(limits::kSmallestGain, DBL_MIN);
+  EXPECT_EQ(limits::kMaxSteps, std::int64_t{1} << 53);
+  EXPECT_EQ(static_cast<double>(limits::kMaxSteps - 1) + 1.0, static_cast<double>(limits::kMaxSteps));
+  EXPECT_EQ(limits::kMaxPacingSeconds, static_cast<double>(INT32_MAX));
+}
+
+TEST(Limits, TimeStepAndKappaSignAndFiniteness) {
+  expectDynamicsRejected(0.0, 1.0, {"time_step: must be finite and > 0, got 0"});
+  expectDynamicsRejected(-0.1, 1.0, {"time_step: must be finite and > 0, got -0.1"});
+  expectDynamicsRejected(NAN, 1.0, {"time_step: must be finite", "got nan"});
+  expectDynamicsRejected(HUGE_VAL, 1.0, {"time_step: must be finite", "got inf"});
+  expectDynamicsRejected(0.01, -2.0, {"kappa: must be finite and >= 0, got -2"});
+  expectDynamicsRejected(0.01, NAN, {"kappa: must be finite", "got nan"});
+  expectDynamicsRejected(0.01, HUGE_VAL, {"kappa: must be finite", "got inf"});
+  expectNormalGains(0.01, 0.0);  // undamped
+}
+
+TEST(Limits, TimeStepWhoseSquareOverflows) {
+  expectDynamicsRejected(1e200, 0.0, {"time_step: must be <= 9.480751908109176e+153 s", "got 1e+200"});
+  expectDynamicsRejected(up(limits::kMaxTimeStep), 0.0, {"time_step: must be <="});
+  expectNormalGains(limits::kMaxTimeStep, 0.0);
+}
+
+TEST(Limits, KappaTimesTimeStepWhoseExponentialOverflows) {
+  // The case: e^{kappa h} = inf, every gain 0, agents frozen at their start.
+  expectDynamicsRejected(0.01, 1e200, {"kappa * time_step: must be <= 708.3964185322641",
+                                       "got 1e+200 * 0.01 = 1e+198"});
+  expectDynamicsRejected(1.0, up(limits::kMaxDampingTimeStep), {"kappa * time_step: must be <="});
+  expectDynamicsRejected(1e10, 1e-7, {"kappa * time_step"});  // 1000: e^{-1000} = 0
+  expectNormalGains(1.0, limits::kMaxDampingTimeStep);
+}
+
+TEST(Limits, GainsThatWouldBeDenormal) {
+  // kappa = 0: 2h^2/(1 + e^0) = h^2, normal from the smallest h with h h >= DBL_MIN on.
+  double hMin = std::sqrt(DBL_MIN);
+  while (hMin * hMin >= DBL_MIN) hMin = down(hMin);
+  while (hMin * hMin < DBL_MIN) hMin = up(hMin);
+  expectNormalGains(hMin, 0.0);
+  expectDynamicsRejected(down(hMin), 0.0, {"time_step: too small, the gain 2h^2/(1 + e^{kappa h})",
+                                           "must be >= 2.2250738585072014e-308"});
+  expectDynamicsRejected(1e-170, 0.0, {"got h = 1e-170 with kappa = 0"});  // h^2 = 0
+  // kappa h within its limit, but h^2 small enough that 2h^2/(1 + e^{kappa h}) is denormal:
+  // 0.5 e^{-708} ~ 1.7e-308.
+  expectDynamicsRejected(0.5, 1416.0, {"time_step: too small", "got h = 0.5 with kappa = 1416"});
+  expectNormalGains(1.0, 708.0);
+}
+
+TEST(Limits, Steps) {
+  expectRejected([] { validateSteps(-1, false); }, {"steps: must be between 0 and 9007199254740992", "got -1"});
+  expectRejected([] { validateSteps(limits::kMaxSteps + 1, false); }, {"steps: must be between"});
+  expectRejected([] { validateSteps(0, true, "--steps"); }, {"--steps: must be >= 1", "got 0"});
+  EXPECT_NO_THROW(validateSteps(0, false));  // unbounded ROS run
+  EXPECT_NO_THROW(validateSteps(1, true));
+  EXPECT_NO_THROW(validateSteps(limits::kMaxSteps, true));
+}
+
+TEST(Limits, RealTimeFactor) {
+  const auto rejected = [](double factor, double h, std::initializer_list<std::string> fragments) {
+    expectRejected([&] { validateRealTimeFactor(factor, h); }, fragments);
+  };
+  rejected(HUGE_VAL, 0.01, {"real_time_factor: must be finite and >= 0", "got inf"});
+  rejected(NAN, 0.01, {"real_time_factor: must be finite", "got nan"});
+  rejected(-1.0, 0.01, {"real_time_factor: must be finite and >= 0", "got -1"});
+  // Pacing sleep h / factor beyond a ROS duration's int32 seconds.
+  rejected(1.0, 1e10, {"real_time_factor: the pacing", "must be <= 2147483647 s", "got 1e+10 / 1 = 1e+10 s"});
+  rejected(1e-300, 0.01, {"real_time_factor: the pacing"});
+  rejected(down(1.0), limits::kMaxPacingSeconds, {"real_time_factor: the pacing"});
+  expectRejected([] { validateRealTimeFactor(-1.0, 0.01, "~real_time_factor"); }, {"~real_time_factor: must"});
+  EXPECT_NO_THROW(validateRealTimeFactor(0.0, 1e10));  // not paced: any h
+  EXPECT_NO_THROW(validateRealTimeFactor(1.0, limits::kMaxPacingSeconds));
+  EXPECT_NO_THROW(validateRealTimeFactor(1e300, 0.01));
+}
+
+TEST(Limits, ScenarioFileValuesGoThroughTheSameChecks) {
+  expectError(replaced(valid(), "time_step: 0.01", "time_step: 1e200"),
+              {"time_step: must be <= 9.480751908109176e+153 s", "got 1e+200"});
+  expectError(replaced(valid(), "kappa: 1.0", "kappa: 1e200"),
+              {"kappa * time_step: must be <= 708.3964185322641", "got 1e+200 * 0.01"});
+  expectError(replaced(valid(), "time_step: 0.01", "time_step: 1e-170"), {"time_step: too small"});
+  expectError(replaced(valid(), "steps: 10", "steps: 9007199254740993"), {"steps: must be between"});
+  // At the boundary: accepted (kappa h = 708 with h = 1), with the stability warning.
+  const Scenario s =
+      parseScenario(replaced(replaced(valid(), "time_step: 0.01", "time_step: 1"), "kappa: 1.0", "kappa: 708"),
+                    "file.yaml");
+  EXPECT_EQ(s.dampingGain * s.timeStep, 708.0);
+}
+
+TEST(Overrides, ReRunTheValidationUnderTheFlagsNames) {
+  const Scenario file = parseScenario(valid(), "file.yaml");
+  ASSERT_TRUE(file.warnings.empty());
+  const auto rejected = [&](const ScenarioOverrides& o, std::initializer_list<std::string> fragments) {
+    Scenario s = file;
+    expectRejected([&] { applyOverrides(s, o, /*requireBoundedSteps=*/true); }, fragments);
+  };
+  ScenarioOverrides o;
+  o.dampingGain = 1e200;
+  rejected(o, {"--kappa * time_step: must be <= 708.3964185322641"});
+  o = {};
+  o.timeStep = 1e200;
+  rejected(o, {"--time-step: must be <= 9.480751908109176e+153 s"});
+  o = {};
+  o.timeStep = -1.0;
+  rejected(o, {"--time-step: must be finite and > 0, got -1"});
+  o = {};
+  o.steps = 0;
+  rejected(o, {"--steps: must be >= 1"});
+
+  // The stability warning is recomputed for the overridden h, and names the flag.
+  Scenario s = file;
+  o = {};
+  o.timeStep = 2.0;
+  o.dampingGain = 0.0;
+  applyOverrides(s, o, true);
+  EXPECT_EQ(s.timeStep, 2.0);
+  EXPECT_EQ(s.dampingGain, 0.0);
+  EXPECT_EQ(s.steps, 10);  // not overridden: the file's value
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_EQ(s.warnings[0].rfind("--time-step: h = 2 exceeds the linear stability limit", 0), 0u) << s.warnings[0];
+  // ... and disappears when an override brings h back below the limit.
+  o.timeStep = 0.01;
+  applyOverrides(s, o, true);
+  EXPECT_TRUE(s.warnings.empty());
 }
 
 }  // namespace

@@ -71,7 +71,11 @@ TEST(Stability, AdviceWarnsAboveTheLimit) {
   EXPECT_FALSE(adviseTimeStep(f, f.desiredShape(), 0.5, 0.0).exceeded);
   const StepSizeAdvice advice = adviseTimeStep(f, f.desiredShape(), 1.5, 0.0);
   EXPECT_TRUE(advice.exceeded);
-  EXPECT_NE(advice.message.find("time_step"), std::string::npos);
+  EXPECT_EQ(advice.message.rfind("time_step: h = 1.5 exceeds the linear stability limit 1 s", 0), 0u)
+      << advice.message;
+  // Named after the flag that set h, when one did.
+  EXPECT_EQ(adviseTimeStep(f, f.desiredShape(), 1.5, 0.0, "--time-step").message.rfind("--time-step: h = 1.5", 0),
+            0u);
 }
 
 }  // namespace

@@ -8,7 +8,9 @@
 #include <vector>
 
 #include "variational_formation/core/error.hpp"
+#include "variational_formation/core/integrator.hpp"
 #include "variational_formation/core/roa.hpp"
+#include "variational_formation/core/stability.hpp"
 #include "variational_formation/tools/roa_cli.hpp"
 
 namespace vf {
@@ -57,8 +59,19 @@ TEST(Roa, SameResultsForOneAndTwoThreads) {
   EXPECT_GT(other, 0);
 }
 
+// The step from which a run stays congruent, measured on any integrator, or -1.
+long stepFromWhichCongruent(Integrator& integ, const Formation& f, long steps) {
+  long lastIncongruent = -1;
+  for (long k = 0; k <= steps; ++k) {
+    if (k > 0) integ.step();
+    if (!f.isCongruent(integ.positions(), integ.velocities())) lastIncongruent = k;
+  }
+  return lastIncongruent < steps ? lastIncongruent + 1 : -1;
+}
+
 TEST(Roa, KnownConvergingAndDivergingCells) {
   const Scenario sc = loadScenario(kHexagon);
+  const Formation f = makeFormation(sc);
   RoaGrid near;
   near.agent = 1;
   near.xMin = near.xMax = sc.desiredPositions(0, 1) + 0.3;
@@ -66,15 +79,26 @@ TEST(Roa, KnownConvergingAndDivergingCells) {
   const RoaCell a = RoaCampaign(sc, near, paperSettings()).run(1)[0];
   EXPECT_TRUE(a.converged);
   EXPECT_FALSE(a.diverged);
-  EXPECT_GT(a.convergedStep, 0);
-  EXPECT_LE(a.convergedStep, 200);
+  // A second method: RK4 at h/10 from the same start reaches congruence at the same time, to
+  // within one step h = 0.014 (the VI's backward-difference velocity lags by about h/2; 0.91 s
+  // against 0.903 s when this was written).
+  Positions q0 = f.desiredShape();
+  q0(0, 1) = near.xMin;
+  q0(1, 1) = near.yMin;
+  const auto rk4 = makeIntegrator(Method::RungeKutta4, f, q0, Positions::Zero(2, 6), 0.0014, 13.0);
+  const long rk4Step = stepFromWhichCongruent(*rk4, f, 2000);
+  ASSERT_GT(rk4Step, 0);
+  EXPECT_NEAR(a.convergedStep * 0.014, rk4Step * 0.0014, 0.014);
 
   RoaGrid far = near;
-  far.xMin = far.xMax = 200.0;  // stiffness ~ 3 |q|^2: h w >> 2 cosh(kappa h / 2)
+  far.xMin = far.xMax = 200.0;
   const RoaCell b = RoaCampaign(sc, far, paperSettings()).run(1)[0];
   EXPECT_TRUE(b.diverged);
-  EXPECT_FALSE(b.converged);
-  EXPECT_EQ(b.convergedStep, -1);
+  // Why: stiffness ~ 3 |q|^2 there, so h w >> 2 cosh(kappa h / 2) (linearly unstable start).
+  Positions qFar = f.desiredShape();
+  qFar(0, 1) = 200.0;
+  qFar(1, 1) = far.yMin;
+  EXPECT_FALSE(isLinearlyStable(0.014, maxStiffnessFrequency(f, qFar), 13.0));
 }
 
 TEST(Roa, BatchedPathEqualsScalarPathBitForBit) {
@@ -144,6 +168,27 @@ TEST(RoaCli, WritesTheGridAndASummary) {
   EXPECT_EQ(rows, 20);
 }
 
+TEST(RoaCli, DivergedCellsAreAResultNotAnError) {
+  // Far from the shape with an overridden, larger h: every cell diverges, exit status 0, and the
+  // override's stability warning is printed.
+  const std::string path = ::testing::TempDir() + "vf_roa_diverged.csv";
+  const CliResult r = roa({"--scenario", kHexagon, "--agent", "1", "--x-range", "200", "201", "--y-range",
+                           "0", "0", "--resolution", "2", "1", "--time-step", "0.2", "--kappa", "0",
+                           "--steps", "50", "--out", path});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.rfind("roa: warning: --time-step: h = 0.2 exceeds the linear stability limit", 0), 0u) << r.err;
+  EXPECT_NE(r.out.find("diverged 100.0%"), std::string::npos) << r.out;
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  int rows = 0;
+  while (std::getline(in, line)) {
+    EXPECT_EQ(line.substr(line.size() - 7), ",0,-1,1") << line;
+    ++rows;
+  }
+  EXPECT_EQ(rows, 2);
+}
+
 TEST(RoaCli, BadArgumentsAreOneLineErrorsWithStatusTwo) {
   const std::string out = ::testing::TempDir() + "vf_roa_bad.csv";
   const std::vector<std::string> base{"--scenario", kHexagon, "--x-range", "0", "1", "--y-range", "0",
@@ -160,7 +205,13 @@ TEST(RoaCli, BadArgumentsAreOneLineErrorsWithStatusTwo) {
       {with({"--agent", "1", "--threads", "0"}), "--threads: must be between 1"},
       {with({"--agent", "1", "--z", "1"}), "--z: only for 3D"},
       {with({"--agent", "1", "--tolerance", "-1"}), "--tolerance: must be > 0"},
-      {with({"--agent", "1", "--kappa", "-1"}), "--kappa: must be finite and >= 0"},
+      {with({"--agent", "1", "--kappa", "-1"}), "--kappa: must be finite and >= 0, got -1"},
+      // Overrides go through the scenario's validation: the limits of README "Limits".
+      {with({"--agent", "1", "--kappa", "1e200"}), "--kappa * time_step: must be <= 708.3964185322641"},
+      {with({"--agent", "1", "--time-step", "1e200"}), "--time-step: must be <= 9.480751908109176e+153 s"},
+      {with({"--agent", "1", "--time-step", "0"}), "--time-step: must be finite and > 0, got 0"},
+      {with({"--agent", "1", "--time-step", "1e-170"}), "--time-step: too small"},
+      {with({"--agent", "1", "--steps", "0"}), "--steps: must be >= 1 here, got 0"},
       {with({"--agent", "1", "--frobnicate"}), "--frobnicate: unknown flag"},
       {{"--scenario", "/nonexistent.yaml", "--agent", "0", "--x-range", "0", "1", "--y-range", "0", "1",
         "--resolution", "2", "2", "--out", out},

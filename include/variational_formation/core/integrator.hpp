@@ -58,7 +58,7 @@ class Integrator {
  * @param q0 initial positions, @param v0 initial velocities (d x n each).
  * @param timeStep h > 0 [s]. @param dampingGain kappa >= 0 [1/s].
  * @param start only used by Method::Variational.
- * @throws InvalidInput on bad sizes or values.
+ * @throws InvalidInput on bad sizes or values (h and kappa: validateDynamics, validation.hpp).
  */
 std::unique_ptr<Integrator> makeIntegrator(Method method, const Formation& formation,
                                            const Positions& q0, const Positions& v0,

@@ -54,11 +54,11 @@ class RoaCampaign {
  public:
   static constexpr int kLanes = 8;
 
-  /// @throws InvalidInput on a bad agent index, grid or settings.
+  /// @throws InvalidInput on a bad agent index, grid or settings (h, kappa and steps through
+  /// validateDynamics and validateSteps, named after the roa flags).
   RoaCampaign(const Scenario& scenario, const RoaGrid& grid, const RoaSettings& settings);
 
   int cellCount() const { return grid_.nx * grid_.ny; }
-  const RoaGrid& grid() const { return grid_; }
   const Formation& formation() const { return formation_; }
 
   /// Runs every cell on `threads` threads (results do not depend on the thread count).

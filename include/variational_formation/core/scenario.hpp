@@ -28,17 +28,11 @@ struct Scenario {
   int agentCount() const { return static_cast<int>(initialPositions.cols()); }
 };
 
-/// Reads and validates a scenario file. @throws InvalidInput "<file>: <field>: <problem>".
+/// Reads a scenario file and validates it (validateScenario, validation.hpp).
+/// @throws InvalidInput "<file>: <field>: <problem>".
 Scenario loadScenario(const std::string& path);
 /// Parses and validates YAML text; `source` prefixes error messages.
 Scenario parseScenario(const std::string& yamlText, const std::string& source);
-/**
- * Checks the numeric fields (after command-line overrides too): finite kappa >= 0, h > 0,
- * steps >= 0 (>= 1 if requireBoundedSteps). Recomputes the warnings.
- * @throws InvalidInput naming the field.
- */
-void validateScenario(Scenario& scenario, bool requireBoundedSteps = false);
-
 /// The formation (desired shape and edges) of a validated scenario.
 Formation makeFormation(const Scenario& scenario);
 

@@ -29,7 +29,8 @@ struct StepSizeAdvice {
 };
 
 /// Advice for step h at configurations q0 and the desired shape (the larger w of the two).
+/// @param field names h in the message (the scenario field, or the flag that set it).
 StepSizeAdvice adviseTimeStep(const Formation& formation, const Positions& q0, double timeStep,
-                              double dampingGain);
+                              double dampingGain, const std::string& field = "time_step");
 
 }  // namespace vf

@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "variational_formation/core/validation.hpp"
+
 namespace vf {
 
 /**
@@ -32,5 +34,9 @@ class Arguments {
  private:
   std::map<std::string, std::vector<std::string>> values_;
 };
+
+/// The scenario overrides --time-step H, --kappa K and --steps N that are present, parsed but
+/// not checked: applyOverrides validates them like the file's values.
+ScenarioOverrides scenarioOverrides(const Arguments& args);
 
 }  // namespace vf

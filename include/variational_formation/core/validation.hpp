@@ -1,0 +1,82 @@
+#pragma once
+
+#include <limits>
+#include <optional>
+#include <string>
+
+#include "variational_formation/core/scenario.hpp"
+
+namespace vf {
+
+/**
+ * The one validation path for the numbers of a run: a scenario file, command-line overrides and
+ * node parameters all go through these functions, so each value is rejected once, with one
+ * line "<field>: <problem>, got <value> (<limit>)", and the warnings are computed once.
+ * The limits are listed in README ("Limits").
+ */
+namespace limits {
+/// Smallest positive normal double. Every gain of the update (e^{-kappa h}, 2h^2/(1 + e^{kappa h}),
+/// 2h/(1 + e^{kappa h})) must be at least this: a denormal gain has lost precision, a zero one
+/// freezes the agents.
+constexpr double kSmallestGain = std::numeric_limits<double>::min();
+/// Largest kappa h [1]: -ln(kSmallestGain), so that e^{-kappa h} is a normal double (e^{kappa h}
+/// itself would overflow only past 709.78).
+constexpr double kMaxDampingTimeStep = 708.3964185322641;
+/// Largest h [s] for which 2 h^2 is finite: (2h) h is evaluated by the update's gain.
+constexpr double kMaxTimeStep = 9.480751908109176e153;
+/// Largest number of steps: step indices up to 2^53 convert to double exactly (t_k = k h).
+constexpr long kMaxSteps = 9007199254740992L;
+/// Longest pacing sleep h / real_time_factor [s]: a ROS duration holds int32 seconds.
+constexpr double kMaxPacingSeconds = 2147483647.0;
+}  // namespace limits
+
+/// The names under which values are reported: the scenario's fields, or the flags that set them.
+struct FieldNames {
+  std::string dampingGain = "kappa";
+  std::string timeStep = "time_step";
+  std::string steps = "steps";
+};
+
+/**
+ * Checks h [s] and kappa [1/s]: finite, h > 0, kappa >= 0, h <= limits::kMaxTimeStep,
+ * kappa h <= limits::kMaxDampingTimeStep, and every gain of the update a normal double.
+ * @throws InvalidInput naming the field, the value and the limit.
+ */
+void validateDynamics(double timeStep, double dampingGain, const FieldNames& names = {});
+
+/// Checks a step count: 0 <= steps <= limits::kMaxSteps, and steps >= 1 if requireBounded
+/// (0 = unbounded is only for the ROS run). @throws InvalidInput naming `field`.
+void validateSteps(long steps, bool requireBounded, const std::string& field = "steps");
+
+/**
+ * Checks a real-time factor (0 = as fast as possible): finite, >= 0, and if > 0 the pacing
+ * duration h / realTimeFactor at most limits::kMaxPacingSeconds.
+ * @param timeStep h [s] of the (validated) scenario. @throws InvalidInput naming `field`.
+ */
+void validateRealTimeFactor(double realTimeFactor, double timeStep,
+                            const std::string& field = "real_time_factor");
+
+/**
+ * Checks the numeric fields (validateDynamics, validateSteps) and the formation, and recomputes
+ * the warnings (a non-rigid desired graph, h above the linear stability limit).
+ * @throws InvalidInput naming the field.
+ */
+void validateScenario(Scenario& scenario, bool requireBoundedSteps = false,
+                      const FieldNames& names = {});
+
+/// Replacements for scenario fields (command-line flags); unset ones keep the file's value.
+struct ScenarioOverrides {
+  std::optional<double> timeStep;
+  std::optional<double> dampingGain;
+  std::optional<long> steps;
+};
+
+/**
+ * Applies the overrides and validates the result again, warnings included. Errors and warnings
+ * about an overridden value name the flag ("--time-step", "--kappa", "--steps").
+ * @throws InvalidInput naming the field or flag.
+ */
+void applyOverrides(Scenario& scenario, const ScenarioOverrides& overrides,
+                    bool requireBoundedSteps);
+
+}  // namespace vf

@@ -1,0 +1,114 @@
+#include "variational_formation/core/validation.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <utility>
+
+#include "variational_formation/core/error.hpp"
+#include "variational_formation/core/stability.hpp"
+#include "variational_formation/core/variational_update.hpp"
+
+namespace vf {
+
+namespace {
+
+// Shortest text that reads back as the same double: the value the user gave, and exact limits.
+std::string show(double x) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, x);
+  return std::string(buffer, result.ptr);
+}
+
+}  // namespace
+
+void validateDynamics(double timeStep, double dampingGain, const FieldNames& names) {
+  const double h = timeStep, kappa = dampingGain;
+  if (!(std::isfinite(kappa) && kappa >= 0.0)) {
+    throw InvalidInput(names.dampingGain + ": must be finite and >= 0, got " + show(kappa));
+  }
+  if (!(std::isfinite(h) && h > 0.0)) {
+    throw InvalidInput(names.timeStep + ": must be finite and > 0, got " + show(h));
+  }
+  if (h > limits::kMaxTimeStep) {
+    throw InvalidInput(names.timeStep + ": must be <= " + show(limits::kMaxTimeStep) +
+                       " s (beyond it 2 h^2 overflows), got " + show(h));
+  }
+  if (kappa * h > limits::kMaxDampingTimeStep) {
+    throw InvalidInput(names.dampingGain + " * " + names.timeStep + ": must be <= " +
+                       show(limits::kMaxDampingTimeStep) +
+                       " (beyond it e^{-kappa h} underflows and the update freezes), got " +
+                       show(kappa) + " * " + show(h) + " = " + show(kappa * h));
+  }
+  // e^{-kappa h} is normal now; the position gains can still underflow when h is tiny.
+  const VariationalCoefficients c(h, kappa);
+  const std::pair<const char*, double> gains[] = {{"2h^2/(1 + e^{kappa h})", c.gradientGain},
+                                                  {"2h/(1 + e^{kappa h})", c.startGain}};
+  for (const auto& [name, gain] : gains) {
+    if (!(gain >= limits::kSmallestGain)) {
+      throw InvalidInput(names.timeStep + ": too small, the gain " + name + " = " + show(gain) +
+                         " must be >= " + show(limits::kSmallestGain) +
+                         " (the smallest normal double), got h = " + show(h) + " with kappa = " +
+                         show(kappa));
+    }
+  }
+}
+
+void validateSteps(long steps, bool requireBounded, const std::string& field) {
+  if (steps < 0 || steps > limits::kMaxSteps) {
+    throw InvalidInput(field + ": must be between 0 and " + std::to_string(limits::kMaxSteps) +
+                       " (2^53), got " + std::to_string(steps));
+  }
+  if (requireBounded && steps == 0) {
+    throw InvalidInput(field + ": must be >= 1 here, got 0 (0 = unbounded is only for the ROS run;" +
+                       " the tools take --steps N)");
+  }
+}
+
+void validateRealTimeFactor(double realTimeFactor, double timeStep, const std::string& field) {
+  if (!(std::isfinite(realTimeFactor) && realTimeFactor >= 0.0)) {
+    throw InvalidInput(field + ": must be finite and >= 0 (0 = as fast as possible), got " +
+                       show(realTimeFactor));
+  }
+  if (realTimeFactor > 0.0 && !(timeStep / realTimeFactor <= limits::kMaxPacingSeconds)) {
+    throw InvalidInput(field + ": the pacing time_step / " + field + " must be <= " +
+                       show(limits::kMaxPacingSeconds) + " s (a ROS duration), got " +
+                       show(timeStep) + " / " + show(realTimeFactor) + " = " +
+                       show(timeStep / realTimeFactor) + " s");
+  }
+}
+
+void validateScenario(Scenario& s, bool requireBoundedSteps, const FieldNames& names) {
+  validateDynamics(s.timeStep, s.dampingGain, names);
+  validateSteps(s.steps, requireBoundedSteps, names.steps);
+  // Formation's constructor checks the edges and the desired shape.
+  const Formation formation = makeFormation(s);
+  s.warnings.clear();
+  if (s.agentCount() >= 2 && !formation.isInfinitesimallyRigid(s.desiredPositions)) {
+    s.warnings.push_back("edges: the desired graph is not infinitesimally rigid (rank " +
+                         std::to_string(formation.rigidityRank(s.desiredPositions)) + ", need " +
+                         std::to_string(rigidEdgeCount(s.dimension, s.agentCount())) +
+                         "): the shape is not determined by its edge lengths");
+  }
+  const StepSizeAdvice advice =
+      adviseTimeStep(formation, s.initialPositions, s.timeStep, s.dampingGain, names.timeStep);
+  if (advice.exceeded) s.warnings.push_back(advice.message);
+}
+
+void applyOverrides(Scenario& s, const ScenarioOverrides& overrides, bool requireBoundedSteps) {
+  FieldNames names;
+  if (overrides.timeStep) {
+    s.timeStep = *overrides.timeStep;
+    names.timeStep = "--time-step";
+  }
+  if (overrides.dampingGain) {
+    s.dampingGain = *overrides.dampingGain;
+    names.dampingGain = "--kappa";
+  }
+  if (overrides.steps) {
+    s.steps = *overrides.steps;
+    names.steps = "--steps";
+  }
+  validateScenario(s, requireBoundedSteps, names);
+}
+
+}  // namespace vf
