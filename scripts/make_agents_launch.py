@@ -43,9 +43,9 @@ def boolean(text):
     fail(f"--required: expected true or false, got '{text}'")
 
 
-def agent_count(scenario):
-    info = subprocess.run(["rosrun", "variational_formation", "scenario_info", "--scenario", scenario],
-                          capture_output=True, text=True)
+def agent_count(scenario, rate):
+    info = subprocess.run(["rosrun", "variational_formation", "scenario_info", "--scenario", scenario,
+                           "--real-time-factor", rate], capture_output=True, text=True)
     if info.returncode != 0:
         lines = info.stderr.strip().splitlines() or ["scenario_info failed"]
         fail(lines[-1].replace("scenario_info: error: ", ""))
@@ -62,7 +62,7 @@ def main():
     parser.add_argument("--required", type=boolean, default="false")
     parser.error = lambda message: fail(message.replace("argument --", ""))
     args = parser.parse_args()
-    count = agent_count(args.scenario)
+    count = agent_count(args.scenario, args.rate)
     ids = list(range(count))
     if args.order == "reverse":
         ids.reverse()

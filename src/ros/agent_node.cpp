@@ -3,6 +3,7 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <ros/callback_queue.h>
 
+#include "variational_formation/core/validation.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/participants.hpp"
 
@@ -17,8 +18,8 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   const std::string path = requiredParam<std::string>(pnh, "scenario");
   realTimeFactor_ = optionalParam(pnh, "real_time_factor", 0.0);
   monitor_ = participantName(nh, optionalParam<std::string>(pnh, "monitor", "monitor"));
-  if (!(realTimeFactor_ >= 0.0)) throw InvalidInput("~real_time_factor: must be >= 0 (0 = as fast as possible)");
   const Scenario scenario = loadScenario(path);
+  validateRealTimeFactor(realTimeFactor_, scenario.timeStep, "~real_time_factor");
   agent_ = std::make_unique<LockstepAgent>(scenario, id);
   name_ = "agent_" + std::to_string(id);
   // Frames carry the namespace, so that two formations side by side have distinct frames.
