@@ -21,6 +21,7 @@ LockstepAgent::LockstepAgent(const Scenario& scenario, int id, StartMethod start
   q_.assign(scenario.initialPositions.col(id).data(),
             scenario.initialPositions.col(id).data() + dimension_);
   qPrev_ = q_;
+  qBeforePrev_ = q_;
   v0_.assign(scenario.initialVelocities.col(id).data(),
              scenario.initialVelocities.col(id).data() + dimension_);
   for (const Neighbour& nb : formation_.neighbours(id)) neighbourIds_.push_back(nb.agent);
@@ -100,9 +101,24 @@ void LockstepAgent::advance() {
   } else {
     paperStart(coefficients_, dimension_, q_.data(), v0_.data(), next.data());
   }
+  qBeforePrev_.swap(qPrev_);
   qPrev_.swap(q_);
   q_.swap(next);
   ++step_;
+}
+
+bool LockstepAgent::finite() const {
+  for (int a = 0; a < dimension_; ++a) {
+    if (!std::isfinite(q_[a]) || !std::isfinite(qPrev_[a])) return false;
+  }
+  return true;
+}
+
+void LockstepAgent::undo() {
+  if (step_ == 0) return;
+  q_.swap(qPrev_);
+  qPrev_.swap(qBeforePrev_);
+  --step_;
 }
 
 }  // namespace vf

@@ -93,7 +93,7 @@ void AgentNode::onProgress(const ros::MessageEvent<RunProgress const>& event) {
 }
 
 void AgentNode::tryAdvance() {
-  while (exitStatus_ < 0 && !agent_->finished() && agent_->step() < allowedStep_ && agent_->ready()) {
+  while (exitStatus_ < 0 && failure_.empty() && !agent_->finished() && agent_->step() < allowedStep_ && agent_->ready()) {
     const ros::WallTime now = ros::WallTime::now();
     if (!started_) {
       started_ = true;
@@ -110,6 +110,15 @@ void AgentNode::tryAdvance() {
       }
     }
     agent_->advance();
+    if (!agent_->finite()) {
+      // Never publish a non-finite state: report the divergence with the last good one, and let
+      // the monitor end the run (doc/distributed.md).
+      failure_ = "step " + std::to_string(agent_->step()) + " is not finite (the run diverged)";
+      ROS_ERROR("%s: %s; ending the run", name_.c_str(), failure_.c_str());
+      agent_->undo();
+      publish();
+      return;
+    }
     publish();
     lastStepAt_ = now;
   }
@@ -125,6 +134,7 @@ void AgentNode::publish() {
   msg.position = agent_->position();
   msg.previous_position = agent_->previousPosition();
   msg.dropped = static_cast<uint32_t>(dropped_);
+  msg.failure = failure_;
   statePub_.publish(msg);
 
   geometry_msgs::TransformStamped t;
@@ -138,6 +148,7 @@ void AgentNode::publish() {
 }
 
 std::string AgentNode::waitingFor() const {
+  if (!failure_.empty()) return "the monitor to end the run (" + failure_ + ")";
   if (agent_->finished()) return "the monitor to end the run (last step " + std::to_string(agent_->step()) + " done)";
   if (agent_->step() >= allowedStep_) {
     return allowedStep_ == 0 ? "the monitor " + monitor_ + " to start the run (it waits for every participant)"

@@ -85,6 +85,9 @@ void MonitorNode::onState(int agent, const ros::MessageEvent<AgentState const>& 
     why = "from " + event.getPublisherName() + ", which does not own it";
   } else if (static_cast<int>(msg.id) != agent) {
     why = "with id " + std::to_string(msg.id);
+  } else if (!msg.failure.empty()) {
+    finish(RunProgress::FAILED, owner.node + ": " + msg.failure);
+    return;
   } else {
     try {
       const auto receipt =

@@ -33,13 +33,14 @@ RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) 
   timeStep_ = scenario.timeStep;
   const int n = scenario.agentCount();
   states_.resize(static_cast<std::size_t>(n));
+  const double splitMb = optionalParam(pnh, "split_size", 256.0);
+  const double maxMb = optionalParam(pnh, "max_size", 1024.0);
+  if (!(splitMb >= 0.0 && splitMb < 1e9)) throw InvalidInput("~split_size: must be in [0, 1e9) MB, got " + std::to_string(splitMb));
+  if (!(maxMb >= 0.0 && maxMb < 1e9)) throw InvalidInput("~max_size: must be in [0, 1e9) MB, got " + std::to_string(maxMb));
+  splitBytes_ = splitMb * 1e6;
+  maxBytes_ = maxMb * 1e6;
   createParentDirectory(path_, "~bag");
-  try {
-    bag_.open(path_, rosbag::bagmode::Write);
-    open_ = true;
-  } catch (const std::exception& e) {
-    throw InvalidInput("~bag: cannot write '" + path_ + "': " + e.what());
-  }
+  openPart();
   const std::string ns = nh.getNamespace() == "/" ? "" : nh.getNamespace().substr(1) + "/";
   framePrefix_ = ns;
   for (int i = 0; i < n; ++i) {
@@ -67,7 +68,46 @@ RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) 
   progressPub_ = pnh.advertise<RunProgress>("progress", 10, true);
   progress_.state = RunProgress::WAITING;
   progress_.completed_step = -1;
-  ROS_INFO("recorder: writing %s (%d agents, %ld steps), monitor %s", path_.c_str(), n, steps_, monitor_.c_str());
+  ROS_INFO("recorder: writing %s (%d agents, %ld steps), monitor %s, %s, %s", path_.c_str(), n, steps_,
+           monitor_.c_str(), maxMb > 0 ? ("at most " + std::to_string(static_cast<long>(maxMb)) + " MB").c_str() : "no size limit",
+           splitMb > 0 ? ("files of " + std::to_string(static_cast<long>(splitMb)) + " MB").c_str() : "one file");
+}
+
+void RecorderNode::openPart() {
+  std::string path = path_;
+  if (part_ > 0) {
+    const std::string stem = path_.size() > 4 && path_.compare(path_.size() - 4, 4, ".bag") == 0
+                                 ? path_.substr(0, path_.size() - 4) : path_;
+    path = stem + "_" + std::to_string(part_) + ".bag";
+  }
+  try {
+    bag_.open(path, rosbag::bagmode::Write);
+    open_ = true;
+  } catch (const std::exception& e) {
+    throw InvalidInput("~bag: cannot write '" + path + "': " + e.what());
+  }
+}
+
+void RecorderNode::enforceLimits() {
+  const double size = static_cast<double>(bag_.getSize());
+  if (maxBytes_ > 0.0 && closedBytes_ + size >= maxBytes_) {
+    limited_ = true;
+    ROS_WARN("recorder: the size limit of %.0f MB ends the recording (%d files); the run goes on", maxBytes_ / 1e6,
+             part_ + 1);
+    close("size limit");
+  } else if (splitBytes_ > 0.0 && size >= splitBytes_) {
+    closedBytes_ += size;
+    close("split");
+    ++part_;
+    try {
+      openPart();
+    } catch (const std::exception& e) {
+      progress_.state = RunProgress::FAILED;
+      progress_.reason = e.what();
+      progressPub_.publish(progress_);
+      exitStatus_ = 1;
+    }
+  }
 }
 
 template <typename M>
@@ -76,6 +116,7 @@ void RecorderNode::write(const std::string& topic, const M& msg, const ros::Time
   try {
     bag_.write(topic, bagTime(stamp), msg);
     ++written_;
+    enforceLimits();
   } catch (const std::exception& e) {
     progress_.state = RunProgress::FAILED;
     progress_.reason = std::string("cannot write ") + path_ + ": " + e.what();

@@ -37,6 +37,10 @@ class LockstepAgent {
   bool holdsNeighbourStep(int j) const;
   /// q_k -> q_{k+1}. Requires ready().
   void advance();
+  /// q_k and q_{k-1} are finite (false once the run has diverged).
+  bool finite() const;
+  /// Back to the state before the last advance() (to report a non-finite step without it).
+  void undo();
 
   int id() const { return id_; }
   long step() const { return step_; }
@@ -66,7 +70,7 @@ class LockstepAgent {
   int id_;
   int dimension_;
   long step_ = 0;
-  std::vector<double> qPrev_, q_, v0_;
+  std::vector<double> qPrev_, q_, v0_, qBeforePrev_;
   std::vector<int> neighbourIds_;
   std::vector<NeighbourState> neighbours_;  // indexed by agent id (only neighbours used)
   Positions view_;                          // q_k of self and neighbours, d x n

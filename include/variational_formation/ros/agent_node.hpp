@@ -60,7 +60,7 @@ class AgentNode {
   ros::WallTime startedAt_, lastStepAt_, lastReportAt_;
   long dropped_ = 0;
   int exitStatus_ = -1;  // -1: running
-  std::string name_, frame_;
+  std::string name_, frame_, failure_;
 };
 
 }  // namespace vf

@@ -28,7 +28,14 @@ using variational_formation::RunProgress;
  * monitor holds the agents back until it has. Bag time is the simulated time t_k, so
  * `rosbag play --clock` replays the run at the simulated pace.
  *
- * Private parameters: ~scenario, ~bag (both required), ~monitor (default "monitor").
+ * Size limits, like `rosbag record --split --size`: ~split_size (MB, default 256; 0 = one file)
+ * starts a new file <bag>_1.bag, <bag>_2.bag, ... once the current one reaches it, and
+ * ~max_size (MB, default 1024; 0 = no limit) ends the recording, with a warning, once all files
+ * together reach it; the run goes on and the recorder keeps counting steps, so it never holds
+ * the agents back afterwards.
+ *
+ * Private parameters: ~scenario, ~bag (both required), ~monitor (default "monitor"),
+ * ~split_size, ~max_size.
  */
 class RecorderNode {
  public:
@@ -52,6 +59,8 @@ class RecorderNode {
   void onMonitorProgress(const ros::MessageEvent<RunProgress const>& event);
   void report();
   void close(const std::string& how);
+  void openPart();
+  void enforceLimits();
 
   ros::NodeHandle nh_;
   rosbag::Bag bag_;
@@ -66,6 +75,9 @@ class RecorderNode {
   Steps status_;
   long markers_ = 0, written_ = 0, repeats_ = 0, dropped_ = 0;
   bool open_ = false;
+  bool limited_ = false;  // the size limit ended the recording
+  double splitBytes_ = 0.0, maxBytes_ = 0.0, closedBytes_ = 0.0;
+  int part_ = 0;
   int exitStatus_ = -1;
 };
 
