@@ -13,6 +13,11 @@ add_library(variational_formation_core
   src/core/simulation.cpp
   src/core/lockstep_agent.cpp
   src/core/monitor.cpp
+  src/core/number_checks.cpp
+  src/core/link_faults.cpp
+  src/core/agent_neighbourhood.cpp
+  src/core/timed_agent.cpp
+  src/core/point_robot.cpp
 )
 target_include_directories(variational_formation_core PUBLIC
   $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/include>)

@@ -57,6 +57,19 @@ inline void paperStart(const VariationalCoefficients& c, int dimension, const do
   }
 }
 
+/**
+ * Velocity form of the explicit update (DESIGN.md §1), for an agent that measures its position:
+ * v_{k+1} = e^{-kappa h} v_k - 2h/(1 + e^{kappa h}) grad_i V(q_{k+1}), then q_{k+2} = q_{k+1} + h v_{k+1}.
+ * Equal to variationalUpdate up to round-off when v_k = (q_{k+1} - q_k)/h.
+ * @param v v_k [m/s]. @param gradient grad_i V(q_{k+1}). @param vNext receives v_{k+1}; d doubles.
+ */
+inline void variationalVelocityUpdate(const VariationalCoefficients& c, int dimension, const double* v,
+                                      const double* gradient, double* vNext) {
+  for (int a = 0; a < dimension; ++a) {
+    vNext[a] = c.decay * v[a] - c.startGain * gradient[a];
+  }
+}
+
 /// How the two-step scheme gets q_1.
 enum class StartMethod { Variational, Paper };
 

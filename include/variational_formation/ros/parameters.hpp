@@ -2,6 +2,7 @@
 
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include <ros/ros.h>
 
@@ -15,6 +16,7 @@ const char* parameterKind() {
   if (std::is_same<T, bool>::value) return "true or false";
   if (std::is_integral<T>::value) return "an integer";
   if (std::is_floating_point<T>::value) return "a number";
+  if (std::is_same<T, std::vector<double>>::value) return "a list of numbers";
   return "a string";
 }
 

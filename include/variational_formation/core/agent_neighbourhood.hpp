@@ -1,0 +1,58 @@
+#pragma once
+
+#include <vector>
+
+#include "variational_formation/core/scenario.hpp"
+
+namespace vf {
+
+/**
+ * What one agent of a distributed run knows of the formation (DESIGN.md §3): its initial state,
+ * its neighbours, the checks of a neighbour's state message, and grad_i V from the positions it
+ * holds, through Formation::agentGradient exactly as the centralised integrators call it.
+ */
+class AgentNeighbourhood {
+ public:
+  /// Why a neighbour's state cannot be used.
+  enum class StateCheck { Usable, UnknownSender, WrongDimension, NonFinite };
+
+  /// @throws InvalidInput if id is not an agent of the (validated) scenario.
+  AgentNeighbourhood(const Scenario& scenario, int id);
+
+  int id() const { return id_; }
+  int dimension() const { return formation_.dimension(); }
+  /// N_i in the order of the scenario's edges.
+  const std::vector<int>& neighbourIds() const { return neighbourIds_; }
+  /// q_0 and v_0 of the scenario [m], [m/s].
+  const std::vector<double>& initialPosition() const { return q0_; }
+  const std::vector<double>& initialVelocity() const { return v0_; }
+
+  /// A state (q, q_prev) from `sender`: a neighbour's, d finite values each.
+  StateCheck check(long sender, const std::vector<double>& position,
+                   const std::vector<double>& previousPosition) const;
+
+  /**
+   * grad_i V(q) (DESIGN.md §1) from the agent's own q_i and the neighbours' positions.
+   * @param own d doubles. @param neighbourPosition(j) d doubles of neighbour j.
+   * @param out d doubles.
+   */
+  template <class NeighbourPosition>
+  void gradient(const double* own, NeighbourPosition neighbourPosition, double* out) {
+    const int d = dimension();
+    for (int a = 0; a < d; ++a) view_(a, id_) = own[a];
+    for (int j : neighbourIds_) {
+      const double* qj = neighbourPosition(j);
+      for (int a = 0; a < d; ++a) view_(a, j) = qj[a];
+    }
+    formation_.agentGradient(id_, view_, out);
+  }
+
+ private:
+  Formation formation_;
+  int id_;
+  std::vector<int> neighbourIds_;
+  std::vector<double> q0_, v0_;
+  Positions view_;  // positions of self and neighbours, d x n (other columns unused)
+};
+
+}  // namespace vf

@@ -1,0 +1,22 @@
+#pragma once
+
+#include <string>
+
+namespace vf {
+
+/**
+ * Checks of single numbers (node parameters, fault settings, robot limits), each failing with one
+ * line "<field>: must be <limit>, got <value>" as InvalidInput. `unit` is appended to the limit
+ * ("s", "m/s", or "" for none).
+ */
+/// value finite and >= lower. @throws InvalidInput
+void requireFiniteAtLeast(const std::string& field, double value, double lower, const std::string& unit);
+/// value finite and > lower. @throws InvalidInput
+void requireFiniteAbove(const std::string& field, double value, double lower, const std::string& unit);
+/// value finite and in [lower, upper]. @throws InvalidInput
+void requireFiniteWithin(const std::string& field, double value, double lower, double upper,
+                         const std::string& unit);
+/// Shortest decimal text that reads back as the same double ("0.1", "-inf", "nan").
+std::string formatNumber(double value);
+
+}  // namespace vf

@@ -1,0 +1,157 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "variational_formation/core/agent_neighbourhood.hpp"
+#include "variational_formation/core/scenario.hpp"
+#include "variational_formation/core/variational_update.hpp"
+
+namespace vf {
+
+/**
+ * One agent of the time-driven mode, without any transport. Unlike LockstepAgent it never waits:
+ * tick(now) is called on every wall-clock tick (period h / rate) and computes q_{k+1} from its
+ * own state and the NEWEST position received from each neighbour, with the same core functions
+ * as LockstepAgent (Formation::agentGradient, variationalUpdate, variationalStart). When every
+ * neighbour's newest state is the one of the previous tick, the trajectory is the centralised
+ * one bit for bit.
+ *
+ * Holding: if a neighbour has never been heard, or its newest state was received more than
+ * maxAge seconds ago, the agent does not move (q_{k+1} = q_k). After a hold it restarts from rest
+ * with the variational start (v = 0); holds before the first move only defer the start from the
+ * scenario's (q_0, v_0). The step k counts ticks, holds included, so that the agent's state
+ * messages keep advancing while it holds and its neighbours do not take it for silent.
+ *
+ * Robot mode: setMeasuredPosition(q) makes the next tick start from the measured position, with
+ * the velocity taken from the agent's own previous command (velocity form of the update,
+ * doc/robots.md), so that measurement noise is never divided by h.
+ *
+ * Times (`now`, receive times, ages, maxAge) are in seconds on one clock of the caller's choice.
+ */
+class TimedAgent {
+ public:
+  /// What became of a received neighbour state.
+  enum class Receipt { Accepted, Outdated, UnknownSender, WrongDimension, NonFinite, NegativeStep };
+
+  /// One neighbour as the agent sees it at some time.
+  struct NeighbourStatus {
+    int id = -1;
+    bool heard = false;  ///< a state was ever accepted
+    long step = -1;      ///< the neighbour's step of the newest accepted state
+    double age = 0.0;    ///< now - its local receive time [s]; +inf if never heard
+    bool stale = true;   ///< never heard, or age > maxAge
+    long accepted = 0;   ///< states accepted from it
+    long dropped = 0;    ///< states from it that were not accepted (outdated, malformed)
+  };
+
+  /// What a tick did.
+  struct TickResult {
+    long step = 0;         ///< the agent's step after the tick
+    bool holding = false;  ///< it did not move, because of the neighbours in `stale`
+    std::vector<NeighbourStatus> stale;  ///< neighbours never heard or older than maxAge
+  };
+
+  /**
+   * @param scenario a validated scenario. @param id the agent's id.
+   * @param maxAge [s] > 0: a neighbour whose newest state is older than this makes the agent hold.
+   * @throws InvalidInput on a bad id or maxAge.
+   */
+  TimedAgent(const Scenario& scenario, int id, double maxAge, StartMethod start = StartMethod::Variational);
+
+  /**
+   * Offers neighbour `sender`'s state at its step m (q_m, q_{m-1}), received at local time `now`.
+   * Accepted if it is the first, or if its step is higher than the held one's, or if the held
+   * one is older than maxAge (a neighbour back from silence, for instance after a respawn, may
+   * restart from a lower step). Anything else is Outdated (a reordered or repeated message).
+   * Never changes the agent's own state.
+   */
+  Receipt receive(long sender, long step, const std::vector<double>& position,
+                  const std::vector<double>& previousPosition, double now);
+
+  /// One wall-clock tick at time `now`: q_k -> q_{k+1}, or a hold. Never blocks.
+  TickResult tick(double now);
+
+  /**
+   * Robot mode: the position measured at the coming tick [m], d values. The next tick starts
+   * from it, with the velocity state v_k from the agent's own previous command. Used once.
+   * @throws InvalidInput on a wrong size or a non-finite value.
+   */
+  void setMeasuredPosition(const std::vector<double>& position);
+
+  /**
+   * kappa [1/s] (dynamic_reconfigure): recomputes the update coefficients; the velocity state
+   * is kept. @throws InvalidInput if kappa is not finite and >= 0.
+   */
+  void setDampingGain(double dampingGain);
+
+  /**
+   * Restarts from a known position at a given step (a respawned agent that recovered its own
+   * newest state), at rest. @throws InvalidInput on a wrong size, non-finite value or step < 0.
+   */
+  void restore(long step, const std::vector<double>& position);
+
+  int id() const { return neighbourhood_.id(); }
+  /// Ticks so far, holds included.
+  long step() const { return step_; }
+  /// scenario steps reached (never for steps = 0, unbounded).
+  bool finished() const { return steps_ > 0 && step_ >= steps_; }
+  /// The last tick held.
+  bool holding() const { return holding_; }
+  /// q_k [m]: after a tick, the new position; in robot mode, the position setpoint q_{k+1}.
+  const std::vector<double>& position() const { return q_; }
+  /// q_{k-1} [m] (the measured position the last update started from, in robot mode).
+  const std::vector<double>& previousPosition() const { return qPrev_; }
+  /// The position setpoint for the robot [m]: same as position().
+  const std::vector<double>& positionSetpoint() const { return q_; }
+  /// v_k [m/s] = (q_{k+1} - q_k) / h of the last tick: the commanded velocity; 0 while holding.
+  const std::vector<double>& commandedVelocity() const { return v_; }
+  double dampingGain() const { return coefficients_.dampingGain; }
+  double timeStep() const { return coefficients_.timeStep; }
+  double maxAge() const { return maxAge_; }
+  const std::vector<int>& neighbourIds() const { return neighbourhood_.neighbourIds(); }
+  /// Every neighbour's status at time `now` [s], in neighbourIds() order.
+  std::vector<NeighbourStatus> neighbourStatus(double now) const;
+  long accepted() const { return accepted_; }
+  /// States refused, for any reason, from any sender.
+  long dropped() const { return dropped_; }
+  /// Ticks that held.
+  long heldTicks() const { return heldTicks_; }
+
+  static std::string describe(Receipt receipt);
+
+ private:
+  struct NeighbourState {
+    bool heard = false;
+    long step = -1;
+    double receivedAt = 0.0;
+    long accepted = 0;
+    long dropped = 0;
+    std::vector<double> position;
+    std::vector<double> previousPosition;
+  };
+  NeighbourStatus status(int j, double now) const;
+  Receipt accept(long sender, long step, const std::vector<double>& position,
+                 const std::vector<double>& previousPosition, double now);
+  void hold();
+  void move(const double* gradient);
+
+  AgentNeighbourhood neighbourhood_;
+  VariationalCoefficients coefficients_;
+  StartMethod start_;
+  long steps_;  // the scenario's, 0 = unbounded
+  int dimension_;
+  double maxAge_;
+  long step_ = 0;
+  bool started_ = false;   // moved at least once: the next move is an update, not a start
+  bool restart_ = false;   // held since the last move: the next move starts from rest
+  bool holding_ = false;
+  bool measured_ = false;  // robot mode: qMeasured_ is the position of the coming tick
+  long heldTicks_ = 0;
+  long accepted_ = 0;
+  long dropped_ = 0;
+  std::vector<double> qPrev_, q_, v_, qMeasured_;
+  std::vector<NeighbourState> neighbours_;  // indexed by agent id (only neighbours used)
+};
+
+}  // namespace vf

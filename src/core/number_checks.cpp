@@ -1,0 +1,43 @@
+#include "variational_formation/core/number_checks.hpp"
+
+#include <charconv>
+#include <cmath>
+
+#include "variational_formation/core/error.hpp"
+
+namespace vf {
+
+namespace {
+
+[[noreturn]] void reject(const std::string& field, const std::string& limit, const std::string& unit,
+                         double value) {
+  throw InvalidInput(field + ": must be " + limit + (unit.empty() ? "" : " " + unit) + ", got " +
+                     formatNumber(value));
+}
+
+}  // namespace
+
+std::string formatNumber(double value) {
+  if (std::isnan(value)) return "nan";
+  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+  char text[32];
+  const auto end = std::to_chars(text, text + sizeof text, value).ptr;
+  return std::string(text, end);
+}
+
+void requireFiniteAtLeast(const std::string& field, double value, double lower, const std::string& unit) {
+  if (!std::isfinite(value) || value < lower) reject(field, "finite and >= " + formatNumber(lower), unit, value);
+}
+
+void requireFiniteAbove(const std::string& field, double value, double lower, const std::string& unit) {
+  if (!std::isfinite(value) || !(value > lower)) reject(field, "finite and > " + formatNumber(lower), unit, value);
+}
+
+void requireFiniteWithin(const std::string& field, double value, double lower, double upper,
+                         const std::string& unit) {
+  if (!std::isfinite(value) || value < lower || value > upper) {
+    reject(field, "finite and in [" + formatNumber(lower) + ", " + formatNumber(upper) + "]", unit, value);
+  }
+}
+
+}  // namespace vf

@@ -1,0 +1,193 @@
+#include "variational_formation/core/timed_agent.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "variational_formation/core/error.hpp"
+#include "variational_formation/core/number_checks.hpp"
+
+namespace vf {
+
+namespace {
+
+void checkPosition(const char* field, const std::vector<double>& q, int dimension) {
+  if (static_cast<int>(q.size()) != dimension) {
+    throw InvalidInput(std::string(field) + ": expected " + std::to_string(dimension) + " values, got " +
+                       std::to_string(q.size()));
+  }
+  for (double x : q) {
+    if (!std::isfinite(x)) throw InvalidInput(std::string(field) + ": must be finite, got " + formatNumber(x));
+  }
+}
+
+}  // namespace
+
+TimedAgent::TimedAgent(const Scenario& scenario, int id, double maxAge, StartMethod start)
+    : neighbourhood_(scenario, id),
+      coefficients_(scenario.timeStep, scenario.dampingGain),
+      start_(start),
+      steps_(scenario.steps),
+      dimension_(scenario.dimension),
+      maxAge_(maxAge) {
+  requireFiniteAbove("max_age", maxAge, 0.0, "s");
+  q_ = neighbourhood_.initialPosition();
+  qPrev_ = q_;
+  v_ = neighbourhood_.initialVelocity();
+  neighbours_.resize(static_cast<std::size_t>(scenario.agentCount()));
+}
+
+std::string TimedAgent::describe(Receipt receipt) {
+  switch (receipt) {
+    case Receipt::Accepted: return "accepted";
+    case Receipt::Outdated: return "not newer than the held state";
+    case Receipt::UnknownSender: return "unknown sender";
+    case Receipt::WrongDimension: return "wrong dimension";
+    case Receipt::NonFinite: return "non-finite value";
+    case Receipt::NegativeStep: return "negative step";
+  }
+  return "?";
+}
+
+TimedAgent::Receipt TimedAgent::receive(long sender, long step, const std::vector<double>& position,
+                                        const std::vector<double>& previousPosition, double now) {
+  const Receipt receipt = accept(sender, step, position, previousPosition, now);
+  if (receipt == Receipt::Accepted) {
+    ++accepted_;
+  } else {
+    ++dropped_;
+    if (receipt != Receipt::UnknownSender) ++neighbours_[static_cast<std::size_t>(sender)].dropped;
+  }
+  return receipt;
+}
+
+TimedAgent::Receipt TimedAgent::accept(long sender, long step, const std::vector<double>& position,
+                                       const std::vector<double>& previousPosition, double now) {
+  switch (neighbourhood_.check(sender, position, previousPosition)) {
+    case AgentNeighbourhood::StateCheck::Usable: break;
+    case AgentNeighbourhood::StateCheck::UnknownSender: return Receipt::UnknownSender;
+    case AgentNeighbourhood::StateCheck::WrongDimension: return Receipt::WrongDimension;
+    case AgentNeighbourhood::StateCheck::NonFinite: return Receipt::NonFinite;
+  }
+  if (step < 0) return Receipt::NegativeStep;
+  NeighbourState& held = neighbours_[static_cast<std::size_t>(sender)];
+  // Keyed by receive time: after a silence longer than maxAge any state is news (a respawned
+  // neighbour may count from a lower step); before that only a higher step is.
+  const bool silent = now - held.receivedAt > maxAge_;
+  if (held.heard && step <= held.step && !silent) return Receipt::Outdated;
+  held.heard = true;
+  held.step = step;
+  held.receivedAt = now;
+  held.position = position;
+  held.previousPosition = previousPosition;
+  ++held.accepted;
+  return Receipt::Accepted;
+}
+
+TimedAgent::NeighbourStatus TimedAgent::status(int j, double now) const {
+  const NeighbourState& held = neighbours_[static_cast<std::size_t>(j)];
+  NeighbourStatus s;
+  s.id = j;
+  s.heard = held.heard;
+  s.step = held.step;
+  s.age = held.heard ? now - held.receivedAt : std::numeric_limits<double>::infinity();
+  s.stale = !held.heard || s.age > maxAge_;
+  s.accepted = held.accepted;
+  s.dropped = held.dropped;
+  return s;
+}
+
+std::vector<TimedAgent::NeighbourStatus> TimedAgent::neighbourStatus(double now) const {
+  std::vector<NeighbourStatus> all;
+  for (int j : neighbourIds()) all.push_back(status(j, now));
+  return all;
+}
+
+TimedAgent::TickResult TimedAgent::tick(double now) {
+  TickResult result;
+  for (int j : neighbourIds()) {
+    NeighbourStatus s = status(j, now);
+    if (s.stale) result.stale.push_back(s);
+  }
+  if (!result.stale.empty()) {
+    hold();
+  } else {
+    if (measured_) q_ = qMeasured_;
+    double gradient[3];
+    neighbourhood_.gradient(
+        q_.data(), [this](int j) { return neighbours_[static_cast<std::size_t>(j)].position.data(); }, gradient);
+    move(gradient);
+  }
+  measured_ = false;
+  ++step_;
+  result.step = step_;
+  result.holding = holding_;
+  return result;
+}
+
+void TimedAgent::hold() {
+  if (measured_) q_ = qMeasured_;
+  qPrev_ = q_;
+  // Before the first move the start from (q_0, v_0) is only deferred; afterwards the agent
+  // has stopped, so it restarts from rest.
+  if (started_) {
+    restart_ = true;
+    v_.assign(static_cast<std::size_t>(dimension_), 0.0);
+  }
+  holding_ = true;
+  ++heldTicks_;
+}
+
+void TimedAgent::move(const double* gradient) {
+  std::vector<double> next(static_cast<std::size_t>(dimension_));
+  const double h = coefficients_.timeStep;
+  if (!started_ || restart_) {
+    const std::vector<double> zero(static_cast<std::size_t>(dimension_), 0.0);
+    const std::vector<double>& vStart = restart_ ? zero : neighbourhood_.initialVelocity();
+    if (start_ == StartMethod::Variational) {
+      variationalStart(coefficients_, dimension_, q_.data(), vStart.data(), gradient, next.data());
+    } else {
+      paperStart(coefficients_, dimension_, q_.data(), vStart.data(), next.data());
+    }
+    for (int a = 0; a < dimension_; ++a) v_[a] = (next[a] - q_[a]) / h;
+  } else if (measured_) {
+    // Robot mode: q_k measured, v_{k-1} from our own command; the noise of q_k is not divided by h.
+    std::vector<double> vNext(static_cast<std::size_t>(dimension_));
+    variationalVelocityUpdate(coefficients_, dimension_, v_.data(), gradient, vNext.data());
+    for (int a = 0; a < dimension_; ++a) next[a] = q_[a] + h * vNext[a];
+    v_.swap(vNext);
+  } else {
+    // DESIGN.md §1 explicit update, as in VariationalIntegrator::step.
+    variationalUpdate(coefficients_, dimension_, qPrev_.data(), q_.data(), gradient, next.data());
+    for (int a = 0; a < dimension_; ++a) v_[a] = (next[a] - q_[a]) / h;
+  }
+  qPrev_.swap(q_);
+  q_.swap(next);
+  started_ = true;
+  restart_ = false;
+  holding_ = false;
+}
+
+void TimedAgent::setMeasuredPosition(const std::vector<double>& position) {
+  checkPosition("measured position", position, dimension_);
+  qMeasured_ = position;
+  measured_ = true;
+}
+
+void TimedAgent::setDampingGain(double dampingGain) {
+  requireFiniteAtLeast("kappa", dampingGain, 0.0, "1/s");
+  coefficients_ = VariationalCoefficients(coefficients_.timeStep, dampingGain);
+}
+
+void TimedAgent::restore(long step, const std::vector<double>& position) {
+  checkPosition("restored position", position, dimension_);
+  if (step < 0) throw InvalidInput("restored step: must be >= 0, got " + std::to_string(step));
+  q_ = position;
+  qPrev_ = position;
+  v_.assign(static_cast<std::size_t>(dimension_), 0.0);
+  step_ = step;
+  started_ = true;
+  restart_ = true;
+  measured_ = false;
+}
+
+}  // namespace vf
