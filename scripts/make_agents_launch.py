@@ -8,7 +8,7 @@ here. Prints the path it wrote (the parameter's value). On bad input: one line o
 exit status 2.
 
 usage: make_agents_launch.py --scenario FILE --out FILE [--rate R] [--order forward|reverse]
-                             [--stagger SECONDS] [--required true|false]
+                             [--stagger SECONDS] [--respawn true|false]
 """
 import argparse
 import math
@@ -35,12 +35,14 @@ def non_negative(flag):
     return parse
 
 
-def boolean(text):
-    if text.lower() in ("true", "1"):
-        return "true"
-    if text.lower() in ("false", "0"):
-        return "false"
-    fail(f"--required: expected true or false, got '{text}'")
+def boolean(flag):
+    def parse(text):
+        if text.lower() in ("true", "1"):
+            return "true"
+        if text.lower() in ("false", "0"):
+            return "false"
+        fail(f"{flag}: expected true or false, got '{text}'")
+    return parse
 
 
 def agent_count(scenario, rate):
@@ -59,7 +61,7 @@ def main():
     parser.add_argument("--rate", type=non_negative("rate"), default="0")
     parser.add_argument("--order", choices=("forward", "reverse"), default="forward")
     parser.add_argument("--stagger", type=non_negative("stagger"), default="0")
-    parser.add_argument("--required", type=boolean, default="false")
+    parser.add_argument("--respawn", type=boolean("respawn"), default="true")
     parser.error = lambda message: fail(message.replace("argument --", ""))
     args = parser.parse_args()
     count = agent_count(args.scenario, args.rate)
@@ -73,7 +75,7 @@ def main():
         prefix = f"bash -c 'sleep {delay:g}; exec \"$0\" \"$@\"'" if delay > 0 else ""
         lines.append('  <include file="$(find variational_formation)/launch/agent.launch">')
         for name, value in (("id", str(i)), ("scenario", args.scenario), ("rate", args.rate),
-                            ("required", args.required), ("launch_prefix", prefix)):
+                            ("respawn", args.respawn), ("launch_prefix", prefix)):
             lines.append(f"    <arg name={quoteattr(name)} value={quoteattr(value)}/>")
         lines.append("  </include>")
     lines.append("</launch>")

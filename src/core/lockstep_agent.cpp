@@ -76,6 +76,17 @@ bool LockstepAgent::holdsNeighbourStep(int j) const {
          neighbourPositionAtStep(neighbours_[static_cast<std::size_t>(j)]) != nullptr;
 }
 
+bool LockstepAgent::neighbourState(int j, long& step, std::vector<double>& position,
+                                   std::vector<double>& previousPosition) const {
+  if (j < 0 || j >= static_cast<int>(neighbours_.size())) return false;
+  const NeighbourState& s = neighbours_[static_cast<std::size_t>(j)];
+  if (s.step < 0) return false;
+  step = s.step;
+  position = s.position;
+  previousPosition = s.previousPosition;
+  return true;
+}
+
 bool LockstepAgent::ready() const {
   for (int j : neighbourIds_) {
     if (!neighbourPositionAtStep(neighbours_[static_cast<std::size_t>(j)])) return false;
@@ -105,6 +116,21 @@ void LockstepAgent::advance() {
   qPrev_.swap(q_);
   q_.swap(next);
   ++step_;
+}
+
+void LockstepAgent::resume(long step, const std::vector<double>& position,
+                           const std::vector<double>& previousPosition) {
+  if (step < 0) throw InvalidInput("resume: step must be >= 0, got " + std::to_string(step));
+  if (static_cast<int>(position.size()) != dimension_ || static_cast<int>(previousPosition.size()) != dimension_) {
+    throw InvalidInput("resume: expected " + std::to_string(dimension_) + " coordinates");
+  }
+  for (int a = 0; a < dimension_; ++a) {
+    if (!std::isfinite(position[a]) || !std::isfinite(previousPosition[a])) throw InvalidInput("resume: non-finite state");
+  }
+  step_ = step;
+  q_ = position;
+  qPrev_ = previousPosition;
+  qBeforePrev_ = previousPosition;
 }
 
 bool LockstepAgent::finite() const {

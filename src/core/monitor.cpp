@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "variational_formation/core/error.hpp"
 #include "variational_formation/core/metrics.hpp"
 
 namespace vf {
@@ -55,6 +56,13 @@ FormationMonitor::Receipt FormationMonitor::add(long id, long step, const std::v
     p.qPrev(a, id) = previousPosition[a];
   }
   return Receipt::Accepted;
+}
+
+void FormationMonitor::startAt(long step, long congruentSince) {
+  if (step < 0) throw InvalidInput("startAt: step must be >= 0, got " + std::to_string(step));
+  pending_.clear();
+  next_ = step;
+  congruentSince_ = congruentSince;
 }
 
 std::vector<int> FormationMonitor::missingAt(long step) const {

@@ -6,6 +6,7 @@
 #include "variational_formation/core/validation.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/service_call.hpp"
 
 namespace vf {
 
@@ -39,6 +40,8 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
       boost::function<void(const ros::MessageEvent<RunProgress const>&)>(
           [this](const ros::MessageEvent<RunProgress const>& e) { onProgress(e); }),
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  recallServer_ = nh.advertiseService(name_ + "/recall", &AgentNode::onRecall, this);
+  historyServer_ = nh.advertiseService(name_ + "/history", &AgentNode::onHistory, this);
   for (const std::string& w : scenario.warnings) ROS_WARN("%s: %s", name_.c_str(), w.c_str());
   ROS_INFO("%s: scenario '%s' (%s), %d neighbours, kappa %g, h %g, %ld steps%s, real-time factor %g, monitor %s",
            name_.c_str(), scenario.name.c_str(), path.c_str(), static_cast<int>(agent_->neighbourIds().size()),
@@ -80,12 +83,18 @@ void AgentNode::onProgress(const ros::MessageEvent<RunProgress const>& event) {
     return;
   }
   const RunProgress& p = *event.getConstMessage();
-  if (p.state == RunProgress::FINISHED) {
-    ROS_INFO("%s: the monitor says the run is finished at step %ld; exiting", name_.c_str(), agent_->step());
-    exitStatus_ = 0;
-  } else if (p.state == RunProgress::FAILED) {
-    ROS_INFO("%s: the monitor says the run failed (%s); exiting", name_.c_str(), p.reason.c_str());
-    exitStatus_ = 1;
+  if (!hasProgress_ || p.completed_step >= lastProgress_.completed_step) {
+    lastProgress_ = p;
+    hasProgress_ = true;
+    while (!history_.empty() && history_.front().step <= p.completed_step) history_.pop_front();
+  }
+  if (p.state == RunProgress::FINISHED || p.state == RunProgress::FAILED) {
+    // Stay up, idle: a respawning agent that exited would only be restarted.
+    if (exitStatus_ < 0) {
+      ROS_INFO("%s: the run is over at step %ld (%s); idle until shut down", name_.c_str(), agent_->step(),
+               p.state == RunProgress::FINISHED ? "finished" : ("failed: " + p.reason).c_str());
+    }
+    exitStatus_ = p.state == RunProgress::FINISHED ? 0 : 1;
   } else {
     allowedStep_ = std::max(allowedStep_, static_cast<long>(p.allowed_step));
     tryAdvance();
@@ -98,10 +107,11 @@ void AgentNode::tryAdvance() {
     if (!started_) {
       started_ = true;
       startedAt_ = now;
+      startStep_ = agent_->step();
     }
     if (realTimeFactor_ > 0.0) {
-      // Step k + 1 is due (k + 1) h / r after the start.
-      const double due = (agent_->step() + 1) * agent_->scenario().timeStep / realTimeFactor_;
+      // Step k + 1 is due (k + 1 - k0) h / r after the start at step k0.
+      const double due = (agent_->step() + 1 - startStep_) * agent_->scenario().timeStep / realTimeFactor_;
       const double wait = due - (now - startedAt_).toSec();
       if (wait > 0.0) {
         paceTimer_ = nh_.createWallTimer(ros::WallDuration(wait), [this](const ros::WallTimerEvent&) { tryAdvance(); },
@@ -136,6 +146,7 @@ void AgentNode::publish() {
   msg.dropped = static_cast<uint32_t>(dropped_);
   msg.failure = failure_;
   statePub_.publish(msg);
+  history_.push_back(msg);
 
   geometry_msgs::TransformStamped t;
   t.header = msg.header;
@@ -163,17 +174,63 @@ std::string AgentNode::waitingFor() const {
 }
 
 void AgentNode::reportWaiting() {
+  if (exitStatus_ >= 0) return;
   const ros::WallTime last = lastStepAt_.isZero() ? lastReportAt_ : std::max(lastStepAt_, lastReportAt_);
   if (secondsSince(last) < kReportEvery) return;
   ROS_INFO("%s: at step %ld, waiting for %s", name_.c_str(), agent_->step(), waitingFor().c_str());
   lastReportAt_ = ros::WallTime::now();
 }
 
+void AgentNode::recover() {
+  long best = -1;
+  RecallState::Response found;
+  std::string from;
+  std::vector<std::string> holders;
+  for (int j : agent_->neighbourIds()) holders.push_back(agentNodeName(nh_, j));
+  holders.push_back(monitor_);  // the fallback: it holds everyone's newest state
+  for (const std::string& holder : holders) {
+    RecallState call;
+    call.request.id = static_cast<uint32_t>(agent_->id());
+    if (!callWithTimeout(holder + "/recall", call, 2.0) || !call.response.held) continue;
+    if (call.response.step > best) {
+      best = call.response.step;
+      found = call.response;
+      from = holder;
+    }
+  }
+  if (best <= 0) {
+    ROS_INFO("%s: nobody holds a state of mine beyond step 0: starting from the scenario", name_.c_str());
+    return;
+  }
+  try {
+    agent_->resume(best, found.position, found.previous_position);
+    ROS_INFO("%s: recovered step %ld from %s; resuming", name_.c_str(), best, from.c_str());
+  } catch (const std::exception& e) {
+    ROS_WARN("%s: cannot resume from %s (%s): starting from the scenario", name_.c_str(), from.c_str(), e.what());
+  }
+}
+
+bool AgentNode::onRecall(RecallState::Request& request, RecallState::Response& response) {
+  long step = -1;
+  response.held = agent_->neighbourState(static_cast<int>(request.id), step, response.position,
+                                         response.previous_position);
+  response.step = step;
+  return true;
+}
+
+bool AgentNode::onHistory(RecallHistory::Request&, RecallHistory::Response& response) {
+  response.states.assign(history_.begin(), history_.end());
+  response.progress = lastProgress_;
+  response.has_progress = hasProgress_;
+  return true;
+}
+
 int AgentNode::run() {
-  publish();  // step 0, latched: whoever connects later still gets it
+  recover();
+  publish();  // the first state (step 0, or the recovered one), latched
   lastReportAt_ = ros::WallTime::now();
   watchTimer_ = nh_.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) { reportWaiting(); });
-  while (ros::ok() && exitStatus_ < 0) ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.1));
+  while (ros::ok()) ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.1));
   ROS_INFO("%s: done at step %ld, %ld states dropped", name_.c_str(), agent_->step(), dropped_);
   return exitStatus_ < 0 ? 0 : exitStatus_;
 }

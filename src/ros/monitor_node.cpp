@@ -9,13 +9,13 @@
 #include "variational_formation/ros/markers.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/service_call.hpp"
 
 namespace vf {
 
 namespace {
 constexpr double kReportEvery = 5.0;   // seconds between "waiting for ..." lines
 constexpr double kCheckAfter = 1.0;    // a step stalled this long makes the monitor look for dead participants
-constexpr double kLeaveTimeout = 5.0;  // seconds the agents get to leave after the end
 
 std::string agentList(const std::vector<int>& ids) {
   std::string s;
@@ -68,9 +68,13 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
             [this](const ros::MessageEvent<RunProgress const>& e) { onRecorderProgress(e); }),
         ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
   }
+  newest_.resize(static_cast<std::size_t>(n));
+  for (auto& m : newest_) m.step = -1;
+  recallServer_ = pnh.advertiseService("recall", &MonitorNode::onRecall, this);
   progress_.state = RunProgress::WAITING;
   progress_.completed_step = -1;
   progress_.allowed_step = 0;
+  progress_.converged_step = -1;
   ROS_INFO("monitor: scenario '%s' (%s), %d agents, %zu edges, %ld steps, window %ld, recorder %s%s",
            monitor_->scenario().name.c_str(), path.c_str(), n, monitor_->formation().edges().size(),
            monitor_->scenario().steps, window_, recording_ ? recorder_.node.c_str() : "none",
@@ -93,6 +97,7 @@ void MonitorNode::onState(int agent, const ros::MessageEvent<AgentState const>& 
       const auto receipt =
           monitor_->add(agent, msg.step, msg.position, msg.previous_position, progress_.allowed_step);
       if (receipt == FormationMonitor::Receipt::Accepted || receipt == FormationMonitor::Receipt::Duplicate) {
+        if (msg.step > newest_[static_cast<std::size_t>(agent)].step) newest_[static_cast<std::size_t>(agent)] = msg;
         owner.seen = true;
         owner.goneSince = ros::WallTime();
         if (receipt == FormationMonitor::Receipt::Accepted) publishCompleted();
@@ -149,6 +154,7 @@ void MonitorNode::publishCompleted() {
     for (auto& m : markers.markers) m.header.stamp = stamp;
     markersPub_.publish(markers);
     convergedStep_ = s.converged ? s.convergedStep : -1;
+    congruentSinceAt_[s.metrics.step] = convergedStep_;
     if (s.converged && reportedConvergence_ != s.convergedStep) {
       ROS_INFO("monitor: congruent with the desired shape since step %ld (t = %.3f s)", s.convergedStep,
                s.convergedStep * monitor_->scenario().timeStep);
@@ -188,6 +194,9 @@ void MonitorNode::updateProgress() {
   if (next.state != progress_.state || next.allowed_step >= progress_.allowed_step + every ||
       (next.allowed_step > progress_.allowed_step && next.allowed_step == last)) {
     next.header.stamp.fromSec(std::max(0L, base) * monitor_->scenario().timeStep);
+    const auto at = congruentSinceAt_.find(base);
+    next.converged_step = at == congruentSinceAt_.end() ? -1 : at->second;
+    congruentSinceAt_.erase(congruentSinceAt_.begin(), congruentSinceAt_.lower_bound(base));
     progress_ = next;
     progressPub_.publish(progress_);
   }
@@ -204,7 +213,7 @@ std::string MonitorNode::waitingFor() const {
   return "nothing";
 }
 
-bool MonitorNode::checkAlive(Participant& p, const std::string& what) {
+bool MonitorNode::checkAlive(Participant& p, const std::string& what, double timeout) {
   if (!p.seen) return true;  // not started yet: the waiting line says so
   const Liveness l = nodeLiveness(p.node);
   if (l == Liveness::Alive) {
@@ -213,12 +222,12 @@ bool MonitorNode::checkAlive(Participant& p, const std::string& what) {
   }
   if (p.goneSince.isZero()) {
     p.goneSince = ros::WallTime::now();
-    if (respawnTimeout_ > 0.0) {
+    if (timeout > 0.0) {
       ROS_WARN("monitor: %s %s is gone (%s); waiting up to %.1f s for it to come back", what.c_str(), p.node.c_str(),
-               describe(l), respawnTimeout_);
+               describe(l), timeout);
     }
   }
-  if (secondsSince(p.goneSince) < respawnTimeout_) return true;
+  if (secondsSince(p.goneSince) < timeout) return true;
   finish(RunProgress::FAILED, what + " " + p.node + " ended before the run was over (" + describe(l) + ")");
   return false;
 }
@@ -229,9 +238,9 @@ void MonitorNode::watch() {
   const double stalled = since.isZero() ? kCheckAfter : secondsSince(since);
   if (stalled >= kCheckAfter) {
     for (int i : monitor_->missingAt(monitor_->nextStep())) {
-      if (!checkAlive(agents_[static_cast<std::size_t>(i)], "agent_" + std::to_string(i))) return;
+      if (!checkAlive(agents_[static_cast<std::size_t>(i)], "agent_" + std::to_string(i), respawnTimeout_)) return;
     }
-    if (recording_ && !checkAlive(recorder_, "the recorder")) return;
+    if (recording_ && !checkAlive(recorder_, "the recorder", 0.0)) return;
   }
   updateProgress();  // a viewer may have come
   if (stalled >= kReportEvery && secondsSince(lastReportAt_) >= kReportEvery) {
@@ -280,7 +289,51 @@ void MonitorNode::finish(uint8_t state, const std::string& reason) {
   progressPub_.publish(progress_);
 }
 
+bool MonitorNode::onRecall(RecallState::Request& request, RecallState::Response& response) {
+  response.held = request.id < newest_.size() && newest_[request.id].step >= 0;
+  if (response.held) {
+    response.step = newest_[request.id].step;
+    response.position = newest_[request.id].position;
+    response.previous_position = newest_[request.id].previous_position;
+  }
+  return true;
+}
+
+void MonitorNode::recover() {
+  // A run in progress has agents that received a progress: ask every agent what it holds.
+  std::vector<RecallHistory::Response> held(agents_.size());
+  long resumeAt = -1, since = -1;
+  for (std::size_t i = 0; i < agents_.size(); ++i) {
+    RecallHistory call;
+    if (!callWithTimeout(agents_[i].node + "/history", call, 2.0)) continue;
+    held[i] = call.response;
+    if (call.response.has_progress && call.response.progress.completed_step + 1 > resumeAt) {
+      resumeAt = call.response.progress.completed_step + 1;
+      since = call.response.progress.converged_step;
+    }
+  }
+  if (resumeAt <= 0) return;  // a new run
+  monitor_->startAt(resumeAt, since);
+  reportedConvergence_ = since >= 0 ? since : -2;
+  firstStepAt_ = startedAt_ = ros::WallTime::now();
+  progress_.state = RunProgress::RUNNING;
+  progress_.completed_step = resumeAt - 1;
+  for (std::size_t i = 0; i < held.size(); ++i) {
+    for (const AgentState& s : held[i].states) {
+      progress_.allowed_step = std::max<long>(progress_.allowed_step, s.step);
+      if (s.step < resumeAt) continue;
+      monitor_->add(static_cast<long>(i), s.step, s.position, s.previous_position, s.step);
+      agents_[i].seen = true;
+      if (s.step > newest_[i].step) newest_[i] = s;
+    }
+  }
+  ROS_INFO("monitor: resuming a run in progress at step %ld (rebuilt from the agents' histories)", resumeAt);
+  lastCompletedAt_ = ros::WallTime::now();
+  publishCompleted();
+}
+
 int MonitorNode::run() {
+  recover();
   lastReportAt_ = ros::WallTime::now();
   progressPub_.publish(progress_);
   watchTimer_ = nh_.createWallTimer(ros::WallDuration(0.5), [this](const ros::WallTimerEvent&) { watch(); });
@@ -298,16 +351,9 @@ int MonitorNode::run() {
     ROS_ERROR("monitor: run failed at step %ld: %s", completedStep(), reason.c_str());
     return 1;
   }
-  // Give the agents and the recorder the final word: wait until they have left (or 5 s).
-  const ros::WallTime end = ros::WallTime::now();
-  while (ros::ok() && secondsSince(end) < kLeaveTimeout) {
-    queue->callAvailable(ros::WallDuration(0.1));
-    std::vector<std::string> nodes;
-    if (!ros::master::getNodes(nodes)) break;
-    bool anyLeft = recording_ && std::find(nodes.begin(), nodes.end(), recorder_.node) != nodes.end();
-    for (const Participant& a : agents_) anyLeft = anyLeft || std::find(nodes.begin(), nodes.end(), a.node) != nodes.end();
-    if (!anyLeft) break;
-  }
+  // Stay up, idle: with respawn, a monitor that exited would only be restarted. formation.launch
+  // ends with end_of_run, which exits on the final progress.
+  while (ros::ok()) queue->callAvailable(ros::WallDuration(0.1));
   return exitStatus_;
 }
 

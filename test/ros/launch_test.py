@@ -5,16 +5,22 @@ subprocesses, on the test's master), with real faults.
 - A recorded run through run_formation.sh succeeds (exit 0) and rviz renders its bag.
 - Bad input (a missing scenario, kappa -1, a bad edge, a bad order or rate, an unwritable
   output_dir) ends the launch with one line naming the cause, and run_formation.sh exits non-zero.
-- An agent killed with SIGKILL, or with `rosnode kill`, ends the run: the monitor's line names it,
+- Without respawn, an agent killed with SIGKILL, or with `rosnode kill`, ends the run: the monitor's line names it,
   the result file says failed, run_formation.sh exits non-zero.
 - Agents started first, each by its own agent.launch (as on robots), with stray subscribers on
   their topics, wait for the monitor and recorder started later (agents:=false): the bag is still
   complete and equals simulate.
 - Flow control: while the monitor is stopped (SIGSTOP), no agent runs past the allowed step.
 - A bad node parameter is one ROS_FATAL line naming it and exit status 2.
+- A diverging scenario ends the run within seconds, with one line naming the agent and the step
+  (the step at which simulate's trajectory of that agent stops being finite).
+- An unbounded recorded run with a small size limit splits its bag and stops recording at the
+  limit, while the run goes on.
 """
 import colorsys
+import csv
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -133,7 +139,8 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
     def check_killed_agent_fails_the_run(self, kill, victim):
         out = os.path.join(self.tmp, "killed")
         watcher = StepWatcher()
-        run = start(["rosrun", PKG, "run_formation.sh", f"scenario:={SCENARIO}", "rate:=1", f"output_dir:={out}"])
+        run = start(["rosrun", PKG, "run_formation.sh", f"scenario:={SCENARIO}", "rate:=1", "respawn:=false",
+                     f"output_dir:={out}"])
         try:
             self.assertTrue(watcher.wait_for(60), "the run did not start")
             kill(victim)
@@ -170,15 +177,16 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
         stray.append(start(["rostopic", "echo", "-n", "1000000", "/formation/status"]))
         agents = [start(["roslaunch", PKG, "agent.launch", f"id:={i}", f"scenario:={SCENARIO}"])
                   for i in range(self.scenario["n"])]
+        logs = []
         try:
             time.sleep(6.5)  # the agents are up and wait for the monitor, saying so
             run = run_formation(f"scenario:={SCENARIO}", "agents:=false", "record:=true", f"output_dir:={out}")
             self.assertEqual(run.returncode, 0, run.stdout[-3000:] + run.stderr[-2000:])
-            logs = []
-            for a in agents:
+            for a in agents:  # the run is over: the agents idle until they are stopped, as on robots
+                os.killpg(a.pid, signal.SIGINT)
                 log, _ = a.communicate(timeout=30)
                 logs.append(log)
-                self.assertEqual(a.returncode, 0, log[-2000:])
+                self.assertIn("the run is over at step 300 (finished)", log)
         finally:
             for p in stray + agents:
                 if p.poll() is None:
@@ -232,10 +240,75 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
         with open(os.path.join(out, "unbounded.result.yaml")) as f:
             self.assertEqual(yaml.safe_load(f)["result"], "stopped")
 
+    def test_diverging_run_ends_naming_the_agent_and_the_step(self):
+        diverging = self.scenario_variant("diverging", time_step=0.2, kappa=0.0)
+        first_nonfinite = {}
+        with tempfile.TemporaryDirectory() as tmp:
+            traj = os.path.join(tmp, "traj.csv")
+            subprocess.run(["rosrun", PKG, "simulate", "--scenario", diverging, "--out", traj], capture_output=True)
+            with open(traj) as f:
+                for row in list(csv.DictReader(f)):
+                    i, k = int(row["agent"]), int(row["step"])
+                    if not all(np.isfinite(float(row[c])) for c in "xy"):
+                        first_nonfinite[i] = min(first_nonfinite.get(i, k), k)
+        self.assertTrue(first_nonfinite, "the variant does not diverge in simulate")
+        started = time.time()
+        run = run_formation(f"scenario:={diverging}", f"output_dir:={self.tmp}/diverging", timeout=60)
+        elapsed = time.time() - started
+        out = run.stdout + run.stderr
+        self.assertNotEqual(run.returncode, 0, out[-3000:])
+        failed = [line for line in out.splitlines() if "monitor: run failed at step" in line]
+        self.assertEqual(len(failed), 1, out[-3000:])
+        named = re.search(r"/formation/agent_(\d+): step (\d+) is not finite", failed[0])
+        self.assertIsNotNone(named, failed[0])
+        agent, step = int(named.group(1)), int(named.group(2))
+        self.assertEqual(step, first_nonfinite[agent], failed[0])
+        self.assertLess(elapsed, 20.0)
+
+    def test_recording_splits_and_stops_at_its_size_limit(self):
+        unbounded = self.scenario_variant("unbounded_recorded", steps=0)
+        out = os.path.join(self.tmp, "limited")
+        watcher = StepWatcher()
+        run = start(["rosrun", PKG, "run_formation.sh", f"scenario:={unbounded}", "record:=true",
+                     "record_max_size:=2", "record_split_size:=0.5", f"output_dir:={out}"])
+        parts = lambda: sorted(f for f in os.listdir(out) if f.endswith(".bag") or f.endswith(".bag.active"))  # noqa: E731
+        try:
+            end = time.time() + 60
+            while time.time() < end and not (os.path.isdir(out) and len(parts()) >= 4 and watcher.step > 3000):
+                time.sleep(0.2)
+            sizes = {f: os.path.getsize(os.path.join(out, f)) for f in parts()}
+            step_then = watcher.step
+            time.sleep(1.0)
+            self.assertEqual(sizes, {f: os.path.getsize(os.path.join(out, f)) for f in parts()},
+                             "the recording went on past its limit")
+            self.assertGreater(watcher.step, step_then, "the run stopped with the recording")
+        finally:
+            watcher.sub.unregister()
+            os.killpg(run.pid, signal.SIGINT)
+            log, _ = run.communicate(timeout=40)
+        self.assertEqual(run.returncode, 0, log[-3000:])
+        self.assertEqual(list(sizes), ["unbounded_recorded.bag"] + [f"unbounded_recorded_{k}.bag" for k in (1, 2, 3)])
+        for f, size in sizes.items():
+            self.assertLess(size, 0.5e6 + 100e3, f)  # a file ends with the message that crossed 0.5 MB
+        self.assertLess(sum(sizes.values()), 2e6 + 100e3)
+        self.assertGreaterEqual(sum(sizes.values()), 2e6)
+        self.assertEqual(log.count("the size limit of 2 MB ends the recording"), 1, log[-3000:])
+        # The parts hold the first steps of every agent, without a gap between files.
+        steps = {i: set() for i in range(self.scenario["n"])}
+        for f in sizes:
+            rec = vf_rostest.Recording(os.path.join(out, f))
+            for (i, k) in rec.states:
+                steps[i].add(k)
+        for i, held in steps.items():
+            self.assertEqual(sorted(held), list(range(len(held))), f"agent {i}")
+            self.assertGreater(len(held), 10)
+
     def test_bad_node_parameters_are_one_fatal_line(self):
         cases = (("monitor", ["_trail_length:=abc"], "~trail_length: expected an integer"),
                  ("monitor", ["_trail_length:=1"], "~trail_length: must be >= 2"),
                  ("monitor", ["_window:=0"], "~window: must be >= 1"),
+                 ("recorder", ["_bag:=/tmp/vf_probe.bag", "_max_size:=-1"], "~max_size: must be in [0, 1e9) MB"),
+                 ("agent", ["_id:=1", "_real_time_factor:=inf"], "~real_time_factor"),
                  ("agent", ["_id:=1", "_real_time_factor:=fast"], "~real_time_factor: expected a number"),
                  ("agent", ["_id:=99"], "id: must be an agent id 0..5, got 99"),
                  ("agent", [], "~id: required parameter missing"))

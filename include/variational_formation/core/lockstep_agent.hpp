@@ -35,8 +35,17 @@ class LockstepAgent {
   bool ready() const;
   /// Neighbour j's q_k is known.
   bool holdsNeighbourStep(int j) const;
+  /// The newest state received from neighbour j (for a restarted neighbour to recover from).
+  /// @return false if none is held.
+  bool neighbourState(int j, long& step, std::vector<double>& position, std::vector<double>& previousPosition) const;
   /// q_k -> q_{k+1}. Requires ready().
   void advance();
+  /**
+   * Resumes at `step` with q_step and q_{step-1} as held by a neighbour or the monitor (crash
+   * recovery): the state is everything the update needs, so the run goes on bit for bit.
+   * @throws InvalidInput on a negative step, a wrong size or a non-finite value.
+   */
+  void resume(long step, const std::vector<double>& position, const std::vector<double>& previousPosition);
   /// q_k and q_{k-1} are finite (false once the run has diverged).
   bool finite() const;
   /// Back to the state before the last advance() (to report a non-finite step without it).

@@ -41,6 +41,12 @@ class FormationMonitor {
   /// compute them, which bounds what is buffered.
   Receipt add(long id, long step, const std::vector<double>& position, const std::vector<double>& previousPosition,
               long lastAllowed);
+  /**
+   * Starts at `step` instead of 0 (a restarted monitor): the steps before it count as completed,
+   * and `congruentSince` is the first step of the congruent stretch holding at step - 1 (-1 if
+   * none). Requires that nothing was added yet.
+   */
+  void startAt(long step, long congruentSince);
   /// Agents whose state at `step` has not arrived (all of them if none has).
   std::vector<int> missingAt(long step) const;
   /// Completed steps in order, each removed from the buffer once returned.

@@ -7,13 +7,19 @@
 #include <ros/ros.h>
 #include <tf2_ros/transform_broadcaster.h>
 
+#include <deque>
+
 #include "variational_formation/AgentState.h"
+#include "variational_formation/RecallHistory.h"
+#include "variational_formation/RecallState.h"
 #include "variational_formation/RunProgress.h"
 #include "variational_formation/core/lockstep_agent.hpp"
 
 namespace vf {
 
 using variational_formation::AgentState;
+using variational_formation::RecallHistory;
+using variational_formation::RecallState;
 using variational_formation::RunProgress;
 
 /**
@@ -21,10 +27,15 @@ using variational_formation::RunProgress;
  * in tryAdvance(), which computes as many steps as the neighbours' states, the monitor's
  * allowed step and the pacing permit. All maths is LockstepAgent's.
  *
+ * On start it asks its neighbours and the monitor for the newest state of its own they hold, and
+ * resumes from the highest step found (crash recovery; at step 0, or when nobody holds anything,
+ * it starts from the scenario). It serves the same question for its neighbours (`~recall`), and
+ * its states after the monitor's last completed step for a restarted monitor (`~history`).
  * It publishes its state at once (latched, step 0 included) and the tf world -> <ns>/agent_<id>;
  * it accepts a neighbour's state only from the node that owns it, and it computes step k only
- * once the monitor's latched `progress` allows k. It exits 0 when the monitor says the run is
- * finished, 1 when the monitor says it failed.
+ * once the monitor's latched `progress` allows k. When the monitor says the run is over it idles
+ * until shut down (a respawning node that exited would only be restarted); its exit status is
+ * then 0 if the run finished, 1 if it failed.
  *
  * Private parameters: ~id, ~scenario (required), ~real_time_factor (0 = as fast as possible),
  * ~monitor (name of the monitor node, relative to the namespace; default "monitor").
@@ -33,7 +44,7 @@ class AgentNode {
  public:
   /// @throws InvalidInput on a missing or bad parameter or scenario.
   AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
-  /// Spins until the monitor ends the run (or shutdown). @return the exit status.
+  /// Spins until shutdown. @return 0, or 1 if the monitor said the run failed.
   int run();
 
  private:
@@ -44,6 +55,9 @@ class AgentNode {
   void reportWaiting();
   std::string waitingFor() const;
   void drop(const std::string& why);
+  void recover();
+  bool onRecall(RecallState::Request& request, RecallState::Response& response);
+  bool onHistory(RecallHistory::Request& request, RecallHistory::Response& response);
 
   ros::NodeHandle nh_;
   std::unique_ptr<LockstepAgent> agent_;
@@ -51,6 +65,11 @@ class AgentNode {
   std::vector<ros::Subscriber> subs_;
   std::vector<std::string> neighbourOwners_;  // full node names, indexed like neighbourIds()
   ros::Subscriber progressSub_;
+  ros::ServiceServer recallServer_, historyServer_;
+  std::deque<AgentState> history_;  // published states after the last completed step
+  RunProgress lastProgress_;
+  bool hasProgress_ = false;
+  long startStep_ = 0;
   std::string monitor_;
   tf2_ros::TransformBroadcaster tf_;
   ros::WallTimer paceTimer_, watchTimer_;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <deque>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -9,6 +10,8 @@
 
 #include "variational_formation/AgentState.h"
 #include "variational_formation/FormationStatus.h"
+#include "variational_formation/RecallHistory.h"
+#include "variational_formation/RecallState.h"
 #include "variational_formation/RunProgress.h"
 #include "variational_formation/core/monitor.hpp"
 
@@ -16,6 +19,8 @@ namespace vf {
 
 using variational_formation::AgentState;
 using variational_formation::FormationStatus;
+using variational_formation::RecallHistory;
+using variational_formation::RecallState;
 using variational_formation::RunProgress;
 
 /**
@@ -30,6 +35,10 @@ using variational_formation::RunProgress;
  * of the recorder node, "" = no recording), ~result_file ("" = none), ~wait_for_viewer (false:
  * with true, the start also waits for a subscriber of `markers`, i.e. rviz), ~respawn_timeout
  * (seconds a dead agent may take to come back before the run fails; 0 = fail at once).
+ *
+ * Recovery: it serves `~recall` (each agent's newest state, for a restarted agent), and when it
+ * starts in the middle of a run it rebuilds the steps it had not completed from the agents'
+ * `~history` and goes on from there.
  */
 class MonitorNode {
  public:
@@ -44,12 +53,14 @@ class MonitorNode {
     bool seen = false;           // has sent a valid message
     ros::WallTime goneSince;     // zero while alive
   };
+  void recover();
+  bool onRecall(RecallState::Request& request, RecallState::Response& response);
   void onState(int agent, const ros::MessageEvent<AgentState const>& event);
   void onRecorderProgress(const ros::MessageEvent<RunProgress const>& event);
   void publishCompleted();
   void updateProgress();
   void watch();
-  bool checkAlive(Participant& p, const std::string& what);
+  bool checkAlive(Participant& p, const std::string& what, double timeout);
   std::string waitingFor() const;
   void finish(uint8_t state, const std::string& reason);
   void writeResult(const std::string& result, const std::string& reason) const;
@@ -61,6 +72,9 @@ class MonitorNode {
   ros::Subscriber recorderSub_;
   ros::Publisher statusPub_, markersPub_, progressPub_;
   ros::WallTimer watchTimer_;
+  ros::ServiceServer recallServer_;
+  std::vector<AgentState> newest_;          // each agent's newest state, for ~recall
+  std::map<long, long> congruentSinceAt_;   // completed step -> first step of its congruent stretch
   std::vector<Participant> agents_;
   Participant recorder_;
   bool recording_ = false;
