@@ -11,6 +11,7 @@
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/roa.hpp"
 #include "variational_formation/tools/arguments.hpp"
+#include "variational_formation/tools/progress.hpp"
 #include "variational_formation/tools/simulate_cli.hpp"
 
 namespace vf {
@@ -24,14 +25,6 @@ const char* kUsage =
     "Region of attraction (paper Section 6.2): for every grid point, agent I starts there at\n"
     "rest and the others at rest at their desired positions. roa.csv:\n"
     "ix,iy,x,y,converged,converged_step,diverged. Exit status 2 on bad input.\n";
-
-void drawBar(std::ostream& err, long done, long total) {
-  const int width = 40;
-  const int filled = total > 0 ? static_cast<int>(width * done / total) : width;
-  err << "\r[" << std::string(static_cast<std::size_t>(filled), '#')
-      << std::string(static_cast<std::size_t>(width - filled), ' ') << "] " << done << '/'
-      << total << std::flush;
-}
 
 }  // namespace
 
@@ -83,7 +76,7 @@ int runRoaCli(int argc, const char* const* argv, std::ostream& out, std::ostream
     const auto start = std::chrono::steady_clock::now();
     std::function<void(long)> progress;
     if (progressToTerminal) {
-      progress = [&](long done) { drawBar(err, done, campaign.cellCount()); };
+      progress = [&](long done) { drawProgressBar(err, done, campaign.cellCount()); };
     }
     const std::vector<RoaCell> cells = campaign.run(threads, progress);
     const double seconds =
