@@ -79,16 +79,8 @@ void DelayedVariationalIntegrator::step() {
       held += d;
     }
     formation_.agentGradient(i, view_, g);
-    if (step_ > 0) {
-      // DESIGN.md §1 explicit update, as in VariationalIntegrator::step.
-      variationalUpdate(coefficients_, d, qPrev_.col(i).data(), q_.col(i).data(), g,
-                        qNext_.col(i).data());
-    } else if (start_ == StartMethod::Variational) {
-      variationalStart(coefficients_, d, q_.col(i).data(), v0_.col(i).data(), g,
-                       qNext_.col(i).data());
-    } else {
-      paperStart(coefficients_, d, q_.col(i).data(), v0_.col(i).data(), qNext_.col(i).data());
-    }
+    variationalStep(coefficients_, start_, step_, d, qPrev_.col(i).data(), q_.col(i).data(),
+                    v0_.col(i).data(), g, qNext_.col(i).data());
   }
   qPrev_.swap(q_);
   q_.swap(qNext_);
