@@ -1,13 +1,12 @@
 #include "variational_formation/core/roa.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <string>
-#include <thread>
 
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/validation.hpp"
+#include "variational_formation/core/parallel.hpp"
 #include "variational_formation/core/variational_integrator.hpp"
 
 namespace vf {
@@ -308,32 +307,11 @@ std::vector<RoaCell> RoaCampaign::run(int threads, const std::function<void(long
   const int cells = cellCount();
   std::vector<RoaCell> results(static_cast<std::size_t>(cells));
   const int batches = (cells + kLanes - 1) / kLanes;
-  std::atomic<int> next{0};
-  std::atomic<long> done{0};
-  const auto worker = [&] {
-    for (int b = next++; b < batches; b = next++) {
-      const int first = b * kLanes;
-      const int count = std::min(kLanes, cells - first);
-      simulateBatch(first, count, &results[static_cast<std::size_t>(first)]);
-      done += count;
-    }
-  };
-  const int extra = std::max(1, threads) - 1;
-  std::vector<std::thread> pool;
-  for (int t = 0; t < extra; ++t) pool.emplace_back(worker);
-  if (progress) {
-    // The calling thread reports progress while the pool works, then joins in.
-    std::thread last(worker);
-    while (done.load() < cells) {
-      progress(done.load());
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    }
-    last.join();
-    progress(done.load());
-  } else {
-    worker();
-  }
-  for (auto& t : pool) t.join();
+  const auto count = [&](int b) { return std::min(kLanes, cells - b * kLanes); };
+  parallelFor(
+      batches, threads,
+      [&](int b) { simulateBatch(b * kLanes, count(b), &results[static_cast<std::size_t>(b * kLanes)]); },
+      [&](int b) { return static_cast<long>(count(b)); }, progress);
   return results;
 }
 

@@ -22,16 +22,8 @@ void VariationalIntegrator::step() {
   for (int i = 0; i < n; ++i) {
     double* g = gradient_.col(i).data();
     formation_.agentGradient(i, q_, g);
-    if (step_ > 0) {
-      // DESIGN.md §1 explicit update; paper eq. (integrator-explicit), errata fixed.
-      variationalUpdate(coefficients_, d, qPrev_.col(i).data(), q_.col(i).data(), g,
-                        qNext_.col(i).data());
-    } else if (start_ == StartMethod::Variational) {
-      variationalStart(coefficients_, d, q_.col(i).data(), v0_.col(i).data(), g,
-                       qNext_.col(i).data());
-    } else {
-      paperStart(coefficients_, d, q_.col(i).data(), v0_.col(i).data(), qNext_.col(i).data());
-    }
+    variationalStep(coefficients_, start_, step_, d, qPrev_.col(i).data(), q_.col(i).data(),
+                    v0_.col(i).data(), g, qNext_.col(i).data());
   }
   qPrev_.swap(q_);
   q_.swap(qNext_);

@@ -12,6 +12,7 @@
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/roa.hpp"
 #include "variational_formation/tools/arguments.hpp"
+#include "variational_formation/tools/progress.hpp"
 #include "variational_formation/tools/simulate_cli.hpp"
 
 namespace vf {
@@ -26,14 +27,6 @@ const char* kUsage =
     "rest and the others at rest at their desired positions. roa.csv:\n"
     "ix,iy,x,y,converged,converged_step,diverged. --time-step, --steps and --kappa override\n"
     "the scenario and are checked like it. Exit status 2 on bad input.\n";
-
-void drawBar(std::ostream& err, long done, long total) {
-  const int width = 40;
-  const int filled = total > 0 ? static_cast<int>(width * done / total) : width;
-  err << "\r[" << std::string(static_cast<std::size_t>(filled), '#')
-      << std::string(static_cast<std::size_t>(width - filled), ' ') << "] " << done << '/'
-      << total << std::flush;
-}
 
 // --agent, --x-range, --y-range, --z (3D: default the agent's desired z), --resolution.
 RoaGrid readGrid(const Arguments& args, const Scenario& scenario) {
@@ -76,7 +69,7 @@ std::vector<RoaCell> runTimed(const RoaCampaign& campaign, int threads, std::ost
   const auto start = std::chrono::steady_clock::now();
   std::function<void(long)> progress;
   if (progressToTerminal) {
-    progress = [&](long done) { drawBar(err, done, campaign.cellCount()); };
+    progress = [&](long done) { drawProgressBar(err, done, campaign.cellCount()); };
   }
   std::vector<RoaCell> cells = campaign.run(threads, progress);
   seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

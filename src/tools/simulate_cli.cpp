@@ -1,8 +1,10 @@
 #include "variational_formation/tools/simulate_cli.hpp"
 
+#include <cstdint>
 #include <fstream>
 #include <ostream>
 
+#include "variational_formation/core/delayed_integrator.hpp"
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/simulation.hpp"
 #include "variational_formation/tools/arguments.hpp"
@@ -15,14 +17,42 @@ const char* kUsage =
     "usage: simulate --scenario FILE --out traj.csv [--metrics metrics.csv]\n"
     "                [--method vi|euler|rk4] [--init variational|paper (vi only)]\n"
     "                [--time-step H] [--steps N] [--kappa K]\n"
+    "                [--delay-steps D] [--loss P [--seed S]]   (vi only)\n"
     "Runs a formation scenario centrally. traj.csv: step,t,agent,x,y,z;\n"
     "metrics.csv: step,t,energy,max_distance_error,px,py,pz,ax,ay,az.\n"
-    "Flags override the scenario file. Exit status 2 on bad input, 1 if the run diverges.\n";
+    "Flags override the scenario file. --delay-steps D: each agent uses its neighbours'\n"
+    "q_j^{k-D}; --loss P: each neighbour state is lost with probability P (seed S, default 1).\n"
+    "Exit status 2 on bad input, 1 if the run diverges.\n";
 
 std::ofstream openOutput(const std::string& flag, const std::string& path) {
   std::ofstream out(path);
   if (!out) throw InvalidInput(flag + ": cannot write '" + path + "'");
   return out;
+}
+
+/// The delayed/lossy model's flags: true (and `delay` filled) if any is given.
+bool parseDelayFlags(const Arguments& args, Method method, DelaySettings& delay) {
+  if (!args.has("--delay-steps") && !args.has("--loss")) {
+    if (args.has("--seed")) throw InvalidInput("--seed: only with --loss");
+    return false;
+  }
+  if (method != Method::Variational) {
+    throw InvalidInput(std::string(args.has("--loss") ? "--loss" : "--delay-steps") +
+                       ": only with --method vi, got --method " + methodName(method));
+  }
+  if (args.has("--delay-steps")) delay.delaySteps = args.integer("--delay-steps", 0, 1000000);
+  if (args.has("--loss")) {
+    delay.lossProbability = args.number("--loss");
+    if (delay.lossProbability < 0.0 || delay.lossProbability > 1.0) {
+      throw InvalidInput("--loss: must be a probability in [0, 1], got " + args.text("--loss"));
+    }
+  }
+  if (args.has("--seed")) {
+    if (!args.has("--loss")) throw InvalidInput("--seed: only with --loss");
+    delay.seed = static_cast<std::uint64_t>(
+        args.integer("--seed", 0, std::numeric_limits<long>::max()));
+  }
+  return true;
 }
 
 }  // namespace
@@ -32,7 +62,7 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
     const Arguments args(argc, argv,
                          {{"--scenario", 1}, {"--out", 1}, {"--metrics", 1}, {"--method", 1},
                           {"--init", 1}, {"--time-step", 1}, {"--steps", 1}, {"--kappa", 1},
-                          {"--help", 0}, {"-h", 0}});
+                          {"--delay-steps", 1}, {"--loss", 1}, {"--seed", 1}, {"--help", 0}, {"-h", 0}});
     if (args.has("--help") || args.has("-h")) {
       out << kUsage;
       return kExitOk;
@@ -45,6 +75,8 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
       throw InvalidInput("--init: only for --method vi (euler and rk4 start from v_0 directly), got --method " +
                          args.text("--method"));
     }
+    DelaySettings delay;
+    const bool delayed = parseDelayFlags(args, method, delay);
     Scenario scenario = loadScenario(args.text("--scenario"));
     applyOverrides(scenario, scenarioOverrides(args), /*requireBoundedSteps=*/true);
     for (const std::string& w : scenario.warnings) err << "simulate: warning: " << w << '\n';
@@ -56,14 +88,19 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
     writeTrajectoryHeader(traj);
     if (withMetrics) writeMetricsHeader(metrics);
     long divergedAt = -1;
-    runScenario(scenario, method, start, [&](const Integrator& integrator) {
+    const auto observe = [&](const Integrator& integrator) {
       writeTrajectoryRows(traj, integrator.stepIndex(), integrator.time(),
                           integrator.positions());
       if (withMetrics) writeMetricsRow(metrics, measure(integrator));
       if (divergedAt < 0 && !integrator.positions().allFinite()) {
         divergedAt = integrator.stepIndex();
       }
-    });
+    };
+    if (delayed) {
+      runDelayedScenario(scenario, start, delay, observe);
+    } else {
+      runScenario(scenario, method, start, observe);
+    }
     traj.flush();
     if (withMetrics) metrics.flush();
     if (!traj || (withMetrics && !metrics)) {

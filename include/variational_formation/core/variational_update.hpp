@@ -73,4 +73,21 @@ inline void variationalVelocityUpdate(const VariationalCoefficients& c, int dime
 /// How the two-step scheme gets q_1.
 enum class StartMethod { Variational, Paper };
 
+/**
+ * One agent's step k -> k + 1 of the centralised integrators: the start at k = 0, the explicit
+ * update after. @param gradient grad_i V at step k (unused by the paper's start).
+ */
+inline void variationalStep(const VariationalCoefficients& c, StartMethod start, long step,
+                            int dimension, const double* qPrev, const double* q, const double* v0,
+                            const double* gradient, double* qNext) {
+  if (step > 0) {
+    // DESIGN.md §1 explicit update; paper eq. (integrator-explicit), errata fixed.
+    variationalUpdate(c, dimension, qPrev, q, gradient, qNext);
+  } else if (start == StartMethod::Variational) {
+    variationalStart(c, dimension, q, v0, gradient, qNext);
+  } else {
+    paperStart(c, dimension, q, v0, qNext);
+  }
+}
+
 }  // namespace vf
