@@ -102,7 +102,7 @@ void Formation::agentGradient(int agent, const Positions& q, double* out) const 
   }
 }
 
-void Formation::gradient(const Positions& q, Positions& out) const {
+void Formation::gradient(const Positions& q, Gradients& out) const {
   out.resize(dimension_, agentCount());
   for (int i = 0; i < agentCount(); ++i) agentGradient(i, q, out.col(i).data());
 }
@@ -178,7 +178,7 @@ double Formation::maxDistanceError(const Positions& q) const {
   return distanceErrors(q).cwiseAbs().maxCoeff();
 }
 
-bool Formation::isCongruent(const Positions& q, const Positions& v, double tolerance,
+bool Formation::isCongruent(const Positions& q, const Velocities& v, double tolerance,
                             double maxSpeed) const {
   const int n = agentCount();
   for (int i = 0; i < n; ++i) {

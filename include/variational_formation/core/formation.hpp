@@ -57,7 +57,7 @@ class Formation {
    */
   void agentGradient(int agent, const Positions& q, double* out) const;
   /// Stacked gradient, d x n, agent by agent through agentGradient.
-  void gradient(const Positions& q, Positions& out) const;
+  void gradient(const Positions& q, Gradients& out) const;
   /// Hessian of V, (dn) x (dn), with agent i in rows/columns [d i, d i + d).
   Eigen::MatrixXd hessian(const Positions& q) const;
 
@@ -79,7 +79,7 @@ class Formation {
    * Congruence (paper Section 6.2): every pairwise distance, over all pairs, is within
    * tolerance (relative) of the desired shape's and every agent's speed is below maxSpeed.
    */
-  bool isCongruent(const Positions& q, const Positions& v, double tolerance = 0.01,
+  bool isCongruent(const Positions& q, const Velocities& v, double tolerance = 0.01,
                    double maxSpeed = 0.1) const;
 
  private:
