@@ -91,7 +91,7 @@ double Formation::agentPotential(int agent, const Positions& q) const {
   return v;
 }
 
-// DESIGN.md §1, gradient; paper Section 6 per-agent formula with Gamma_ij = |q_i - q_j|^2 - d_ij^2.
+// doc/maths.md §1, gradient; paper Section 6 per-agent formula with Gamma_ij = |q_i - q_j|^2 - d_ij^2.
 void Formation::agentGradient(int agent, const Positions& q, double* out) const {
   const double* qi = q.col(agent).data();
   for (int c = 0; c < dimension_; ++c) out[c] = 0.0;

@@ -183,7 +183,7 @@ void RoaCampaign::simulateBatch(int first, int count, RoaCell* out,
           qNext[x] = q[x] + c.startGain * (0.0 - 0.5 * c.timeStep * g[x]);
         }
       } else {
-        // DESIGN.md §1 explicit update (variationalUpdate).
+        // doc/maths.md §2, explicit update (variationalUpdate).
         for (int x = 0; x < stride; ++x) {
           qNext[x] = c.positionGain * q[x] - c.decay * qPrev[x] - c.gradientGain * g[x];
         }

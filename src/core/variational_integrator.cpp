@@ -23,7 +23,7 @@ void VariationalIntegrator::step() {
     double* g = gradient_.col(i).data();
     formation_.agentGradient(i, q_, g);
     if (step_ > 0) {
-      // DESIGN.md §1 explicit update; paper eq. (integrator-explicit), errata fixed.
+      // doc/maths.md §2, explicit update; paper eq. (integrator-explicit), errata fixed.
       variationalUpdate(coefficients_, d, qPrev_.col(i).data(), q_.col(i).data(), g,
                         qNext_.col(i).data());
     } else if (start_ == StartMethod::Variational) {

@@ -141,7 +141,7 @@ TEST(HamiltonianFlow, ReproducesTheIntegratorsMomentaAndPositions) {
 }
 
 TEST(HamiltonianFlow, MomentumMatchingHoldsAlongTrajectory) {
-  // The update is exactly p-_{k} = p+_{k} (DESIGN.md §1).
+  // The update is exactly p-_{k} = p+_{k} (doc/maths.md §4).
   const Problem p;
   const double h = 0.01, kappa = 5.0;
   VariationalIntegrator vi(p.formation, p.q0, p.v0, h, kappa, StartMethod::Variational);

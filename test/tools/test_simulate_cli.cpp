@@ -1,4 +1,4 @@
-// The simulate CLI (DESIGN.md §4): formats, overrides, and one-line errors with exit status 2.
+// The simulate CLI (doc/architecture.md, file formats): formats, overrides, and one-line errors with exit status 2.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -44,13 +44,13 @@ class Formation {
   const std::vector<Neighbour>& neighbours(int agent) const { return neighbours_[agent]; }
   const Positions& desiredShape() const { return desiredShape_; }
 
-  /// V(q), DESIGN.md §1.
+  /// V(q), doc/maths.md §1.
   double potential(const Positions& q) const;
   /// 1/2 sum_{j in N_i} V_ij(q): each edge's potential split half to each endpoint.
   double agentPotential(int agent, const Positions& q) const;
 
   /**
-   * grad_i V = sum_{j in N_i} (|q_i - q_j|^2 - d_ij^2)(q_i - q_j) (DESIGN.md §1; the paper's
+   * grad_i V = sum_{j in N_i} (|q_i - q_j|^2 - d_ij^2)(q_i - q_j) (doc/maths.md §1; the paper's
    * Gamma_ij with its erratum fixed). Reads only column i and the columns of N_i, so the
    * agent node and the centralised run call this very function on the same numbers.
    * @param out d doubles.

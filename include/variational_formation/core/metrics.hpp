@@ -6,7 +6,7 @@
 namespace vf {
 
 /**
- * Discrete momenta, energy and Noether quantities of DESIGN.md §1. All momenta are the
+ * Discrete momenta, energy and Noether quantities of doc/maths.md §4-6. All momenta are the
  * unweighted ones (divided by e^{kappa t}), so none of these ever forms e^{kappa t}.
  */
 
@@ -40,7 +40,7 @@ Vector3 linearMomentum(const Momenta& p);
 /// A = sum_i q_i x p_i (in 2D, only z is nonzero).
 Vector3 angularMomentum(const Positions& q, const Momenta& p);
 
-/// Noether's prediction e^{-kappa t_k} X_0 = (e^{-kappa h})^k X_0 (DESIGN.md §1).
+/// Noether's prediction e^{-kappa t_k} X_0 = (e^{-kappa h})^k X_0 (doc/maths.md §6).
 Vector3 noetherPrediction(const Vector3& initial, const VariationalCoefficients& c, long step);
 
 /// |X - prediction| / max(|X_0|, 1e-300): the residual the Noether tests bound.

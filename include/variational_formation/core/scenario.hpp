@@ -9,7 +9,7 @@
 namespace vf {
 
 /**
- * One scenario file (DESIGN.md §4). Loaded and checked by one path, shared by the CLIs and the
+ * One scenario file (doc/architecture.md, file formats). Loaded and checked by one path, shared by the CLIs and the
  * nodes. Positions are d x n, agents in id order.
  */
 struct Scenario {

@@ -4,7 +4,7 @@
 
 namespace vf {
 
-/// The centralised explicit variational integrator (DESIGN.md §1), agent by agent.
+/// The centralised explicit variational integrator (doc/maths.md §2), agent by agent.
 class VariationalIntegrator : public Integrator {
  public:
   VariationalIntegrator(const Formation& formation, const Positions& q0, const Velocities& v0,
