@@ -12,9 +12,12 @@ class FirstOrderIntegrator : public Integrator {
   Momenta momenta() const override { return v_; }
   double energy() const override;
 
- protected:
+  /// @param q0 [m], @param v0 [m/s], d x n each; @param timeStep h [s]; @param dampingGain
+  /// kappa [1/s]. Public so that each scheme inherits it; the class stays abstract (step()).
   FirstOrderIntegrator(const Formation& formation, const Positions& q0, const Velocities& v0,
                        double timeStep, double dampingGain);
+
+ protected:
   /// a = -kappa v - grad V(q).
   void acceleration(const Positions& q, const Velocities& v, Accelerations& out) const;
 
@@ -25,9 +28,7 @@ class FirstOrderIntegrator : public Integrator {
 /// Explicit Euler on (q, v): the paper's comparison (Section 6.1).
 class ExplicitEulerIntegrator : public FirstOrderIntegrator {
  public:
-  ExplicitEulerIntegrator(const Formation& formation, const Positions& q0, const Velocities& v0,
-                          double timeStep, double dampingGain)
-      : FirstOrderIntegrator(formation, q0, v0, timeStep, dampingGain) {}
+  using FirstOrderIntegrator::FirstOrderIntegrator;
   void step() override;
 
  private:
@@ -37,9 +38,7 @@ class ExplicitEulerIntegrator : public FirstOrderIntegrator {
 /// Classical fourth-order Runge-Kutta on (q, v): the accuracy baseline.
 class RungeKutta4Integrator : public FirstOrderIntegrator {
  public:
-  RungeKutta4Integrator(const Formation& formation, const Positions& q0, const Velocities& v0,
-                        double timeStep, double dampingGain)
-      : FirstOrderIntegrator(formation, q0, v0, timeStep, dampingGain) {}
+  using FirstOrderIntegrator::FirstOrderIntegrator;
   void step() override;
 
  private:
