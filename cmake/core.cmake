@@ -1,5 +1,6 @@
-# The ROS-free core: Eigen and yaml-cpp only. catkin's include path is deliberately absent,
-# so a ROS header cannot compile here.
+# The ROS-free core: Eigen and yaml-cpp only. catkin's include path is not given to this
+# target, but on Debian the ROS headers live in /usr/include beside Eigen's, so that alone
+# cannot stop a ROS include from compiling: test/core/test_layers.cpp is the guard.
 add_library(variational_formation_core
   src/core/formation.cpp
   src/core/variational_update.cpp

@@ -10,8 +10,10 @@ import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import vf_plots  # noqa: E402
+# The package is importable once devel/setup.bash is sourced; this also finds it in a checkout.
+sys.path.append(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "src"))
+from variational_formation import data, plots  # noqa: E402
+from variational_formation.cli import fail  # noqa: E402
 
 
 def main():
@@ -24,8 +26,8 @@ def main():
     try:
         import rosbag
     except ImportError:
-        vf_plots.fail("python3-rosbag is not installed (run with /usr/bin/python3)")
-    scenario = vf_plots.read_scenario(args.scenario)
+        fail("python3-rosbag is not installed (run with /usr/bin/python3)")
+    scenario = data.read_scenario(args.scenario)
     n, dimension, kappa, h = scenario.n, scenario.dimension, scenario.kappa, scenario.time_step
     positions, status = {}, {}
     try:
@@ -37,13 +39,13 @@ def main():
                 else:
                     positions[(msg.step, msg.id)] = list(msg.position) + [0.0] * (3 - len(msg.position))
     except Exception as e:  # rosbag raises several unrelated types for unreadable files
-        vf_plots.fail(f"{args.bag}: cannot read the bag ({e})")
+        fail(f"{args.bag}: cannot read the bag ({e})")
     steps = sorted(status)
     if not steps or steps != list(range(len(steps))):
-        vf_plots.fail(f"{args.bag}: the status messages do not cover steps 0..N without gaps")
+        fail(f"{args.bag}: the status messages do not cover steps 0..N without gaps")
     missing = [(k, i) for k in steps for i in range(n) if (k, i) not in positions]
     if missing:
-        vf_plots.fail(f"{args.bag}: {len(missing)} agent states missing, first (step, agent) = {missing[0]}")
+        fail(f"{args.bag}: {len(missing)} agent states missing, first (step, agent) = {missing[0]}")
     q = np.array([[positions[(k, i)] for i in range(n)] for k in steps])
     t = np.array([status[k].time for k in steps])
     energy = np.array([status[k].energy for k in steps])
@@ -52,12 +54,12 @@ def main():
     a = np.array([[status[k].angular_momentum.x, status[k].angular_momentum.y, status[k].angular_momentum.z]
                   for k in steps])
     prefix = args.prefix or scenario.name or "run"
-    for path in vf_plots.plot_all(args.out_dir, prefix, prefix + " (distributed)", t, q, dimension,
+    for path in plots.plot_all(args.out_dir, prefix, prefix + " (distributed)", t, q, dimension,
                                   energy, error, p, a, kappa, h, scenario.edges).values():
         print(f"wrote {path}")
     last = status[steps[-1]]
     print(f"converged: {'yes, from step %d' % last.converged_step if last.converged else 'no'}")
-    print(vf_plots.summary(t, energy, error, p, a, kappa, h))
+    print(plots.summary(t, energy, error, p, a, kappa, h))
 
 
 if __name__ == "__main__":

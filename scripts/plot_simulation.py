@@ -8,10 +8,9 @@ import argparse
 import os
 import sys
 
-import numpy as np
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import vf_plots  # noqa: E402
+# The package is importable once devel/setup.bash is sourced; this also finds it in a checkout.
+sys.path.append(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "src"))
+from variational_formation import data, plots  # noqa: E402
 
 
 def main():
@@ -22,23 +21,16 @@ def main():
     parser.add_argument("--out-dir", default="output")
     parser.add_argument("--prefix", default=None)
     args = parser.parse_args()
-    scenario = vf_plots.read_scenario(args.scenario)
-    n, dimension, kappa, edges = scenario.n, scenario.dimension, scenario.kappa, scenario.edges
-    traj = vf_plots.load_csv(args.traj, "step,t,agent,x,y,z")
-    metrics = vf_plots.load_csv(args.metrics, "step,t,energy,max_distance_error,px,py,pz,ax,ay,az")
-    if traj.shape[0] % n != 0 or traj.shape[0] == 0:
-        vf_plots.fail(f"{args.traj}: {traj.shape[0]} rows is not a multiple of {n} agents")
-    steps = traj.shape[0] // n
-    q = traj[:, 3:6].reshape(steps, n, 3)
-    t = metrics[:, 1]
-    h = t[1] - t[0] if len(t) > 1 else 1.0
+    scenario = data.read_scenario(args.scenario)
+    q = data.read_trajectory(args.traj, scenario.n)
+    m = data.read_metrics(args.metrics)
+    h = m.t[1] - m.t[0] if len(m.t) > 1 else 1.0
     prefix = args.prefix or scenario.name or "run"
-    paths = vf_plots.plot_all(args.out_dir, prefix, prefix, t, q, dimension, metrics[:, 2],
-                              metrics[:, 3], metrics[:, 4:7], metrics[:, 7:10], kappa, h, edges)
+    paths = plots.plot_all(args.out_dir, prefix, prefix, m.t, q, scenario.dimension, m.energy, m.error,
+                           m.p, m.a, scenario.kappa, h, scenario.edges)
     for p in paths.values():
         print(f"wrote {p}")
-    print(vf_plots.summary(t, metrics[:, 2], metrics[:, 3], metrics[:, 4:7], metrics[:, 7:10],
-                           kappa, h))
+    print(plots.summary(m.t, m.energy, m.error, m.p, m.a, scenario.kappa, h))
 
 
 if __name__ == "__main__":

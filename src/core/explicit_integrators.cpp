@@ -5,15 +5,15 @@
 namespace vf {
 
 FirstOrderIntegrator::FirstOrderIntegrator(const Formation& formation, const Positions& q0,
-                                           const Positions& v0, double timeStep,
+                                           const Velocities& v0, double timeStep,
                                            double dampingGain)
     : Integrator(formation, timeStep, dampingGain), q_(q0), v_(v0) {}
 
 double FirstOrderIntegrator::energy() const { return continuousEnergy(formation_, q_, v_); }
 
 // Paper eq. (formation3): v' = -kappa v - grad V(q).
-void FirstOrderIntegrator::acceleration(const Positions& q, const Positions& v,
-                                        Positions& out) const {
+void FirstOrderIntegrator::acceleration(const Positions& q, const Velocities& v,
+                                        Accelerations& out) const {
   formation_.gradient(q, out);
   out = -dampingGain_ * v - out;
 }

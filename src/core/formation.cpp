@@ -91,7 +91,7 @@ double Formation::agentPotential(int agent, const Positions& q) const {
   return v;
 }
 
-// DESIGN.md §1, gradient; paper Section 6 per-agent formula with Gamma_ij = |q_i - q_j|^2 - d_ij^2.
+// doc/maths.md §1, gradient; paper Section 6 per-agent formula with Gamma_ij = |q_i - q_j|^2 - d_ij^2.
 void Formation::agentGradient(int agent, const Positions& q, double* out) const {
   const double* qi = q.col(agent).data();
   for (int c = 0; c < dimension_; ++c) out[c] = 0.0;
@@ -102,7 +102,7 @@ void Formation::agentGradient(int agent, const Positions& q, double* out) const 
   }
 }
 
-void Formation::gradient(const Positions& q, Positions& out) const {
+void Formation::gradient(const Positions& q, Gradients& out) const {
   out.resize(dimension_, agentCount());
   for (int i = 0; i < agentCount(); ++i) agentGradient(i, q, out.col(i).data());
 }
@@ -178,7 +178,7 @@ double Formation::maxDistanceError(const Positions& q) const {
   return distanceErrors(q).cwiseAbs().maxCoeff();
 }
 
-bool Formation::isCongruent(const Positions& q, const Positions& v, double tolerance,
+bool Formation::isCongruent(const Positions& q, const Velocities& v, double tolerance,
                             double maxSpeed) const {
   const int n = agentCount();
   for (int i = 0; i < n; ++i) {

@@ -14,15 +14,6 @@ Method parseMethod(const std::string& text, const std::string& field) {
   throw InvalidInput(field + ": unknown method '" + text + "' (expected vi, euler or rk4)");
 }
 
-std::string methodName(Method method) {
-  switch (method) {
-    case Method::Variational: return "vi";
-    case Method::ExplicitEuler: return "euler";
-    case Method::RungeKutta4: return "rk4";
-  }
-  return "?";
-}
-
 StartMethod parseStartMethod(const std::string& text, const std::string& field) {
   if (text == "variational") return StartMethod::Variational;
   if (text == "paper") return StartMethod::Paper;
@@ -30,7 +21,7 @@ StartMethod parseStartMethod(const std::string& text, const std::string& field) 
 }
 
 std::unique_ptr<Integrator> makeIntegrator(Method method, const Formation& formation,
-                                           const Positions& q0, const Positions& v0,
+                                           const Positions& q0, const Velocities& v0,
                                            double timeStep, double dampingGain,
                                            StartMethod start) {
   const int d = formation.dimension();

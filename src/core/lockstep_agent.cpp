@@ -105,7 +105,7 @@ void LockstepAgent::advance() {
   formation_.agentGradient(id_, view_, gradient);
   std::vector<double> next(static_cast<std::size_t>(dimension_));
   if (step_ > 0) {
-    // DESIGN.md §1 explicit update, as in VariationalIntegrator::step.
+    // doc/maths.md §2, explicit update, as in VariationalIntegrator::step.
     variationalUpdate(coefficients_, dimension_, qPrev_.data(), q_.data(), gradient, next.data());
   } else if (start_ == StartMethod::Variational) {
     variationalStart(coefficients_, dimension_, q_.data(), v0_.data(), gradient, next.data());

@@ -5,28 +5,28 @@
 
 namespace vf {
 
-Positions discreteMomentumPlus(const Formation& formation, const VariationalCoefficients& c,
+Momenta discreteMomentumPlus(const Formation& formation, const VariationalCoefficients& c,
                                const Positions& qk, const Positions& qk1) {
-  Positions grad;
+  Gradients grad;
   formation.gradient(qk1, grad);
-  const Positions v = (qk1 - qk) / c.timeStep;
+  const Velocities v = (qk1 - qk) / c.timeStep;
   return (0.5 * c.positionGain) * v - (0.5 * c.timeStep) * grad;
 }
 
-Positions discreteMomentumMinus(const Formation& formation, const VariationalCoefficients& c,
+Momenta discreteMomentumMinus(const Formation& formation, const VariationalCoefficients& c,
                                 const Positions& qk, const Positions& qk1) {
-  Positions grad;
+  Gradients grad;
   formation.gradient(qk, grad);
-  const Positions v = (qk1 - qk) / c.timeStep;
+  const Velocities v = (qk1 - qk) / c.timeStep;
   // (1 + e^{kappa h}) / 2 = (2h / startGain) / 2 = h / startGain
   return (c.timeStep / c.startGain) * v + (0.5 * c.timeStep) * grad;
 }
 
 void discreteHamiltonianFlow(const Formation& formation, const VariationalCoefficients& c,
-                             const Positions& qk, const Positions& pk, Positions& qk1,
-                             Positions& pk1) {
+                             const Positions& qk, const Momenta& pk, Positions& qk1,
+                             Momenta& pk1) {
   // p_k = ((1 + e^{kappa h})/2) v_k + (h/2) grad V(q_k)  =>  v_k = startGain/h (p_k - h/2 grad)
-  Positions grad;
+  Gradients grad;
   formation.gradient(qk, grad);
   qk1 = qk + c.startGain * (pk - (0.5 * c.timeStep) * grad);
   pk1 = discreteMomentumPlus(formation, c, qk, qk1);
@@ -49,12 +49,12 @@ Eigen::VectorXd agentDiscreteEnergy(const Formation& formation, double timeStep,
   return e;
 }
 
-double continuousEnergy(const Formation& formation, const Positions& q, const Positions& v) {
+double continuousEnergy(const Formation& formation, const Positions& q, const Velocities& v) {
   return 0.5 * v.squaredNorm() + formation.potential(q);
 }
 
 Eigen::VectorXd agentContinuousEnergy(const Formation& formation, const Positions& q,
-                                      const Positions& v) {
+                                      const Velocities& v) {
   Eigen::VectorXd e(formation.agentCount());
   for (int i = 0; i < formation.agentCount(); ++i) {
     e(i) = 0.5 * v.col(i).squaredNorm() + formation.agentPotential(i, q);
@@ -62,7 +62,7 @@ Eigen::VectorXd agentContinuousEnergy(const Formation& formation, const Position
   return e;
 }
 
-Vector3 linearMomentum(const Positions& p) {
+Vector3 linearMomentum(const Momenta& p) {
   Vector3 total = Vector3::Zero();
   for (Eigen::Index i = 0; i < p.cols(); ++i) {
     for (Eigen::Index a = 0; a < p.rows(); ++a) total(a) += p(a, i);
@@ -70,7 +70,7 @@ Vector3 linearMomentum(const Positions& p) {
   return total;
 }
 
-Vector3 angularMomentum(const Positions& q, const Positions& p) {
+Vector3 angularMomentum(const Positions& q, const Momenta& p) {
   Vector3 total = Vector3::Zero();
   for (Eigen::Index i = 0; i < q.cols(); ++i) {
     Vector3 qi = Vector3::Zero();

@@ -14,7 +14,7 @@ StepMetrics measure(const Integrator& integrator) {
   m.time = integrator.time();
   m.energy = integrator.energy();
   m.maxDistanceError = integrator.formation().maxDistanceError(integrator.positions());
-  const Positions p = integrator.momenta();
+  const Momenta p = integrator.momenta();
   m.linearMomentum = linearMomentum(p);
   m.angularMomentum = angularMomentum(integrator.positions(), p);
   return m;

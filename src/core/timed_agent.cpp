@@ -156,7 +156,7 @@ void TimedAgent::move(const double* gradient) {
     for (int a = 0; a < dimension_; ++a) next[a] = q_[a] + h * vNext[a];
     v_.swap(vNext);
   } else {
-    // DESIGN.md §1 explicit update, as in VariationalIntegrator::step.
+    // doc/maths.md §2, explicit update, as in VariationalIntegrator::step.
     variationalUpdate(coefficients_, dimension_, qPrev_.data(), q_.data(), gradient, next.data());
     for (int a = 0; a < dimension_; ++a) v_[a] = (next[a] - q_[a]) / h;
   }

@@ -5,7 +5,7 @@
 namespace vf {
 
 VariationalIntegrator::VariationalIntegrator(const Formation& formation, const Positions& q0,
-                                             const Positions& v0, double timeStep,
+                                             const Velocities& v0, double timeStep,
                                              double dampingGain, StartMethod start)
     : Integrator(formation, timeStep, dampingGain),
       coefficients_(timeStep, dampingGain),
@@ -14,7 +14,7 @@ VariationalIntegrator::VariationalIntegrator(const Formation& formation, const P
       qPrev_(q0),
       q_(q0),
       qNext_(q0),
-      gradient_(Positions::Zero(q0.rows(), q0.cols())) {}
+      gradient_(Gradients::Zero(q0.rows(), q0.cols())) {}
 
 void VariationalIntegrator::step() {
   const int d = formation_.dimension();
@@ -30,12 +30,12 @@ void VariationalIntegrator::step() {
   ++step_;
 }
 
-Positions VariationalIntegrator::velocities() const {
+Velocities VariationalIntegrator::velocities() const {
   if (step_ == 0) return v0_;
   return (q_ - qPrev_) / timeStep_;
 }
 
-Positions VariationalIntegrator::momenta() const {
+Momenta VariationalIntegrator::momenta() const {
   if (step_ == 0) return v0_;
   return discreteMomentumPlus(formation_, coefficients_, qPrev_, q_);
 }

@@ -4,7 +4,7 @@
 
 namespace vf {
 
-// DESIGN.md §1: only e^{+-kappa h} appear, never e^{kappa t}.
+// doc/maths.md §2 and §6: only e^{+-kappa h} appear, never e^{kappa t}.
 VariationalCoefficients::VariationalCoefficients(double h, double kappa)
     : timeStep(h), dampingGain(kappa) {
   const double growth = std::exp(kappa * h);  // e^{kappa h}

@@ -82,18 +82,38 @@ FormationStatus toStatusMessage(const FormationSnapshot& s) {
   return msg;
 }
 
-visualization_msgs::MarkerArray makeMarkers(const FormationSnapshot& s, const Formation& formation,
-                                            const std::vector<std::deque<Eigen::Vector3d>>& trails) {
-  using visualization_msgs::Marker;
-  visualization_msgs::MarkerArray out;
-  const ros::Time stamp = ros::Time::now();
-  const int n = formation.agentCount();
-  // Size markers to the formation: a tenth of the shortest desired edge (1 m without edges).
+namespace {
+
+using visualization_msgs::Marker;
+
+/// Marker radius: a tenth of the shortest desired edge (1 m without edges), at least 5 cm.
+double markerRadius(const Formation& formation) {
   double scale = formation.edges().empty() ? 1.0 : HUGE_VAL;
   for (const Edge& e : formation.edges()) scale = std::min(scale, e.desiredDistance);
-  const double radius = std::max(0.05, 0.1 * scale);
+  return std::max(0.05, 0.1 * scale);
+}
 
-  for (int i = 0; i < n; ++i) {
+/// Where the desired shape is drawn: its agents moved so that its centroid is the formation's.
+struct Ghost {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();         ///< of the current positions
+  Eigen::Vector3d desiredCentroid = Eigen::Vector3d::Zero();  ///< of the desired shape
+
+  Ghost(const FormationSnapshot& s, const Formation& formation) {
+    const int n = formation.agentCount();
+    for (int i = 0; i < n; ++i) {
+      centroid += column3(s.positions, i) / n;
+      desiredCentroid += column3(formation.desiredShape(), i) / n;
+    }
+  }
+  geometry_msgs::Point agent(const Formation& formation, int i) const {
+    return point(column3(formation.desiredShape(), i) - desiredCentroid + centroid);
+  }
+};
+
+/// Per agent, a sphere at q_i and a line strip through its trail (at least two points).
+void addAgentsAndTrails(const FormationSnapshot& s, const std::vector<std::deque<Eigen::Vector3d>>& trails,
+                        int agents, double radius, const ros::Time& stamp, visualization_msgs::MarkerArray& out) {
+  for (int i = 0; i < agents; ++i) {
     Marker m = base("agents", i, Marker::SPHERE, stamp);
     m.pose.position = point(column3(s.positions, i));
     m.scale.x = m.scale.y = m.scale.z = 2.0 * radius;
@@ -108,18 +128,18 @@ visualization_msgs::MarkerArray makeMarkers(const FormationSnapshot& s, const Fo
     if (trail.points.size() < 2) trail.points.assign(2, point(column3(s.positions, i)));
     out.markers.push_back(trail);
   }
+}
 
+/// The edges, green (no error) to red (|error| >= 10% of d_ij), and the desired shape's edges
+/// as a faint ghost; nothing without edges.
+void addEdgesAndGhostEdges(const FormationSnapshot& s, const Formation& formation, const Ghost& ghostAt,
+                           double radius, const ros::Time& stamp, visualization_msgs::MarkerArray& out) {
   Marker edges = base("edges", 0, Marker::LINE_LIST, stamp);
   edges.scale.x = 0.3 * radius;
   edges.color = rgba(0.2, 0.8, 0.2, 1.0);
   Marker ghost = base("desired_shape", 0, Marker::LINE_LIST, stamp);
   ghost.scale.x = 0.2 * radius;
   ghost.color = rgba(0.7, 0.7, 0.7, 0.35);
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero(), desiredCentroid = Eigen::Vector3d::Zero();
-  for (int i = 0; i < n; ++i) {
-    centroid += column3(s.positions, i) / n;
-    desiredCentroid += column3(formation.desiredShape(), i) / n;
-  }
   for (std::size_t e = 0; e < formation.edges().size(); ++e) {
     const Edge& edge = formation.edges()[e];
     const double badness = std::min(1.0, std::abs(s.edgeDistanceErrors(static_cast<long>(e))) /
@@ -128,26 +148,33 @@ visualization_msgs::MarkerArray makeMarkers(const FormationSnapshot& s, const Fo
     for (int end : {edge.tail, edge.head}) {
       edges.points.push_back(point(column3(s.positions, end)));
       edges.colors.push_back(c);
-      ghost.points.push_back(point(column3(formation.desiredShape(), end) - desiredCentroid + centroid));
+      ghost.points.push_back(ghostAt.agent(formation, end));
     }
   }
   if (!edges.points.empty()) {
     out.markers.push_back(edges);
     out.markers.push_back(ghost);
   }
-  Marker ghostAgents = base("desired_shape", 1, Marker::SPHERE_LIST, stamp);
-  ghostAgents.scale.x = ghostAgents.scale.y = ghostAgents.scale.z = 1.2 * radius;
-  ghostAgents.color = rgba(0.7, 0.7, 0.7, 0.25);
-  for (int i = 0; i < n; ++i) {
-    ghostAgents.points.push_back(point(column3(formation.desiredShape(), i) - desiredCentroid + centroid));
-  }
-  out.markers.push_back(ghostAgents);
+}
 
+/// The desired shape's agents as faint spheres.
+Marker ghostAgents(const Formation& formation, const Ghost& ghostAt, double radius, const ros::Time& stamp) {
+  Marker m = base("desired_shape", 1, Marker::SPHERE_LIST, stamp);
+  m.scale.x = m.scale.y = m.scale.z = 1.2 * radius;
+  m.color = rgba(0.7, 0.7, 0.7, 0.25);
+  for (int i = 0; i < formation.agentCount(); ++i) m.points.push_back(ghostAt.agent(formation, i));
+  return m;
+}
+
+/// Step, time, energy, error and convergence, beside the formation (beyond its largest y and
+/// z), not on top of its agents.
+Marker statusText(const FormationSnapshot& s, int agents, const Ghost& ghostAt, double radius,
+                  const ros::Time& stamp) {
   Marker text = base("text", 0, Marker::TEXT_VIEW_FACING, stamp);
-  // Beside the formation (beyond its largest y and z), not on top of its agents.
   Eigen::Vector3d corner = column3(s.positions, 0);
-  for (int i = 1; i < n; ++i) corner = corner.cwiseMax(column3(s.positions, i));
-  text.pose.position = point(Eigen::Vector3d(centroid.x(), corner.y() + 4.0 * radius, corner.z() + 2.0 * radius));
+  for (int i = 1; i < agents; ++i) corner = corner.cwiseMax(column3(s.positions, i));
+  text.pose.position = point(Eigen::Vector3d(ghostAt.centroid.x(), corner.y() + 4.0 * radius,
+                                             corner.z() + 2.0 * radius));
   text.scale.z = 1.5 * radius;
   text.color = rgba(1.0, 1.0, 1.0, 1.0);
   char buf[160];
@@ -155,7 +182,22 @@ visualization_msgs::MarkerArray makeMarkers(const FormationSnapshot& s, const Fo
                 s.metrics.time, s.metrics.energy, s.metrics.maxDistanceError,
                 s.converged ? "  converged" : "");
   text.text = buf;
-  out.markers.push_back(text);
+  return text;
+}
+
+}  // namespace
+
+visualization_msgs::MarkerArray makeMarkers(const FormationSnapshot& s, const Formation& formation,
+                                            const std::vector<std::deque<Eigen::Vector3d>>& trails) {
+  visualization_msgs::MarkerArray out;
+  const ros::Time stamp = ros::Time::now();
+  const int n = formation.agentCount();
+  const double radius = markerRadius(formation);
+  const Ghost ghostAt(s, formation);
+  addAgentsAndTrails(s, trails, n, radius, stamp, out);
+  addEdgesAndGhostEdges(s, formation, ghostAt, radius, stamp, out);
+  out.markers.push_back(ghostAgents(formation, ghostAt, radius, stamp));
+  out.markers.push_back(statusText(s, n, ghostAt, radius, stamp));
   return out;
 }
 

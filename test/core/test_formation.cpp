@@ -22,7 +22,7 @@ Positions randomPositions(int d, int n, unsigned seed, double scale = 2.0) {
 TEST(Formation, GradientMatchesCentralDifferences) {
   const Formation f = test::tetrahedron();
   const Positions q = randomPositions(3, 4, 1);
-  Positions g;
+  Gradients g;
   f.gradient(q, g);
   const double eps = 1e-6;
   for (int i = 0; i < 4; ++i) {
@@ -44,12 +44,13 @@ TEST(Formation, HessianMatchesDifferencesOfGradient) {
   const double eps = 1e-6;
   for (int j = 0; j < 3; ++j) {
     for (int b = 0; b < 2; ++b) {
-      Positions qp = q, qm = q, gp, gm;
+      Positions qp = q, qm = q;
+      Gradients gp, gm;
       qp(b, j) += eps;
       qm(b, j) -= eps;
       f.gradient(qp, gp);
       f.gradient(qm, gm);
-      const Positions column = (gp - gm) / (2 * eps);
+      const Gradients column = (gp - gm) / (2 * eps);
       for (int i = 0; i < 3; ++i)
         for (int a = 0; a < 2; ++a)
           EXPECT_NEAR(h(2 * i + a, 2 * j + b), column(a, i), 1e-5 * std::max(1.0, h.norm()));
@@ -64,7 +65,7 @@ TEST(Formation, AgentPotentialsSumToPotentialAndVanishAtDesiredShape) {
   for (int i = 0; i < 4; ++i) sum += f.agentPotential(i, q);
   EXPECT_NEAR(sum, f.potential(q), 1e-12 * f.potential(q));
   EXPECT_LT(f.potential(f.desiredShape()), 1e-28);
-  Positions g;
+  Gradients g;
   f.gradient(f.desiredShape(), g);
   EXPECT_LT(g.norm(), 1e-14);
 }
@@ -73,7 +74,7 @@ TEST(Formation, GradientIsTranslationAndRotationInvariant) {
   // SE(d) invariance of V is what the Noether laws rest on: the gradients sum to zero.
   const Formation f = test::tetrahedron();
   const Positions q = randomPositions(3, 4, 4);
-  Positions g;
+  Gradients g;
   f.gradient(q, g);
   EXPECT_LT(g.rowwise().sum().norm(), 1e-12 * g.norm());
   Eigen::Vector3d torque = Eigen::Vector3d::Zero();
@@ -148,7 +149,7 @@ TEST(Congruence, RigidMotionsAndReflectionsAreCongruent) {
       Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   Positions moved = rot * f.desiredShape();
   moved.colwise() += Eigen::Vector3d(5, -2, 1);
-  const Positions still = Positions::Zero(3, 4);
+  const Velocities still = Velocities::Zero(3, 4);
   EXPECT_TRUE(f.isCongruent(moved, still));
   Positions mirrored = f.desiredShape();
   mirrored.row(2) *= -1.0;
@@ -157,13 +158,13 @@ TEST(Congruence, RigidMotionsAndReflectionsAreCongruent) {
 
 TEST(Congruence, DistanceAndSpeedThresholds) {
   const Formation f = test::triangle();
-  const Positions still = Positions::Zero(2, 3);
+  const Velocities still = Velocities::Zero(2, 3);
   Positions stretched = f.desiredShape();
   stretched(0, 1) = 1.02;  // pair (0,1) 2% long
   EXPECT_FALSE(f.isCongruent(stretched, still));
   stretched(0, 1) = 1.005;  // 0.5% long, and the other pairs change by less
   EXPECT_TRUE(f.isCongruent(stretched, still));
-  Positions moving = still;
+  Velocities moving = still;
   moving(1, 2) = 0.11;
   EXPECT_FALSE(f.isCongruent(f.desiredShape(), moving));
   moving(1, 2) = 0.09;
@@ -174,7 +175,7 @@ TEST(Congruence, DistanceAndSpeedThresholds) {
   Positions rhombus(2, 4);
   rhombus << 0, 1, 1.5, 0.5, 0, 0, 0.8660254037844386, 0.8660254037844386;
   EXPECT_LT(open.maxDistanceError(rhombus), 1e-12);
-  EXPECT_FALSE(open.isCongruent(rhombus, Positions::Zero(2, 4)));
+  EXPECT_FALSE(open.isCongruent(rhombus, Velocities::Zero(2, 4)));
 }
 
 TEST(Formation, DistanceErrorsPerEdge) {

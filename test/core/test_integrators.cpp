@@ -15,12 +15,12 @@ namespace {
 struct Problem {
   Formation formation = test::tetrahedron();
   Positions q0;
-  Positions v0;
+  Velocities v0;
   Problem() {
     q0 = formation.desiredShape();
     q0.col(0) += Eigen::Vector3d(0.3, -0.2, 0.1);
     q0.col(2) += Eigen::Vector3d(-0.1, 0.25, 0.2);
-    v0 = Positions::Zero(3, 4);
+    v0 = Velocities::Zero(3, 4);
     v0.col(1) = Eigen::Vector3d(0.5, 0.2, -0.4);
     v0.col(3) = Eigen::Vector3d(-0.3, 0.6, 0.1);
   }
@@ -129,7 +129,8 @@ TEST(HamiltonianFlow, ReproducesTheIntegratorsMomentaAndPositions) {
   const double h = 0.01, kappa = 2.0;
   VariationalIntegrator vi(p.formation, p.q0, p.v0, h, kappa, StartMethod::Variational);
   const VariationalCoefficients c(h, kappa);
-  Positions q = p.q0, pk = p.v0, qn, pn;
+  Positions q = p.q0, qn;
+  Momenta pk = p.v0, pn;  // p_0 = v_0: the variational start
   for (int k = 0; k < 300; ++k) {
     discreteHamiltonianFlow(p.formation, c, q, pk, qn, pn);
     vi.step();
@@ -141,7 +142,7 @@ TEST(HamiltonianFlow, ReproducesTheIntegratorsMomentaAndPositions) {
 }
 
 TEST(HamiltonianFlow, MomentumMatchingHoldsAlongTrajectory) {
-  // The update is exactly p-_{k} = p+_{k} (DESIGN.md §1).
+  // The update is exactly p-_{k} = p+_{k} (doc/maths.md §4).
   const Problem p;
   const double h = 0.01, kappa = 5.0;
   VariationalIntegrator vi(p.formation, p.q0, p.v0, h, kappa, StartMethod::Variational);
@@ -150,8 +151,8 @@ TEST(HamiltonianFlow, MomentumMatchingHoldsAlongTrajectory) {
   for (int k = 0; k < 200; ++k) {
     const Positions qPrev = vi.previousPositions(), q = vi.positions();
     vi.step();
-    const Positions plus = discreteMomentumPlus(p.formation, c, qPrev, q);
-    const Positions minus = discreteMomentumMinus(p.formation, c, q, vi.positions());
+    const Momenta plus = discreteMomentumPlus(p.formation, c, qPrev, q);
+    const Momenta minus = discreteMomentumMinus(p.formation, c, q, vi.positions());
     ASSERT_LT((plus - minus).norm(), 1e-11 * (1.0 + plus.norm())) << "step " << k;
   }
 }

@@ -19,7 +19,7 @@ Residuals noetherResiduals(double kappa, long steps, double h, bool zeroMeanVelo
   const Formation f = test::tetrahedron();
   Positions q0 = f.desiredShape();
   q0.col(1) += Eigen::Vector3d(0.4, -0.3, 0.2);
-  Positions v0(3, 4);
+  Velocities v0(3, 4);
   v0 << 0.8, -0.3, 0.1, 0.5, -0.6, 0.9, 0.2, -0.4, 0.3, 0.7, -0.5, 0.6;
   if (zeroMeanVelocity) v0.colwise() -= v0.rowwise().mean();
   VariationalIntegrator vi(f, q0, v0, h, kappa, StartMethod::Variational);
@@ -29,7 +29,7 @@ Residuals noetherResiduals(double kappa, long steps, double h, bool zeroMeanVelo
   Residuals r;
   for (long k = 1; k <= steps; ++k) {
     vi.step();
-    const Positions p = vi.momenta();
+    const Momenta p = vi.momenta();
     // With a zero total momentum, the residual is absolute (relative to 1).
     r.linear = std::max(r.linear, noetherResidual(linearMomentum(p), noetherPrediction(p0, c, k),
                                                   zeroMeanVelocity ? Vector3(1, 0, 0) : p0));

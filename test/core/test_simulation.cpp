@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <iostream>
+#include <utility>
 
 #include "test_support.hpp"
 #include "variational_formation/core/error.hpp"
@@ -43,6 +45,40 @@ TEST(Simulation, ConvergingScenariosEndCongruent) {
     // Settled with a margin: congruent for at least the last tenth of the run.
     EXPECT_GE(o.congruentSince, 0) << name;
     EXPECT_LE(o.congruentSince, s.steps - s.steps / 10) << name;
+  }
+}
+
+/// Time [s] from which an RK4 run at a tenth of the scenario's step stays congruent (-1 if
+/// it never does): a second method, independent of the variational scheme.
+double rk4CongruentSince(const Scenario& s) {
+  const Formation f = makeFormation(s);
+  const double h = s.timeStep / 10.0;
+  auto rk4 = makeIntegrator(Method::RungeKutta4, f, s.initialPositions, s.initialVelocities, h, s.dampingGain);
+  double since = -1.0;
+  for (long k = 0; k <= 10 * s.steps; ++k) {
+    if (k > 0) rk4->step();
+    if (!f.isCongruent(rk4->positions(), rk4->velocities())) since = -1.0;
+    else if (since < 0.0) since = rk4->time();
+  }
+  return since;
+}
+
+TEST(Simulation, CongruenceOnsetAgreesWithRungeKutta4AtATenthOfTheStep) {
+  // The steps below are regression pins: each is the code's own output (`simulate`, quoted in
+  // the scenario file's comment), not an independent fact. The independent check is RK4: the
+  // variational run must become congruent at the same time to within 2.5 of its steps (its
+  // speeds are difference quotients, half a step behind, and the thresholds are crossed slowly).
+  const std::pair<const char*, long> pinned[] = {{"tetrahedron", 847}, {"square", 905}, {"hexagon", 210},
+                                                 {"grid24", 320}};
+  for (const auto& [name, pin] : pinned) {
+    const Scenario s = loadScenario(test::configPath(name));
+    const Outcome o = run(s);
+    const double reference = rk4CongruentSince(s);
+    ASSERT_GE(reference, 0.0) << name;
+    std::cout << name << ": variational from step " << o.congruentSince << " (t = "
+              << o.congruentSince * s.timeStep << " s), RK4 at h/10 from t = " << reference << " s\n";
+    EXPECT_NEAR(o.congruentSince * s.timeStep, reference, 2.5 * s.timeStep) << name;
+    EXPECT_EQ(o.congruentSince, pin) << name << " (regression pin)";
   }
 }
 

@@ -7,7 +7,7 @@
 namespace vf {
 
 /**
- * What one agent of a distributed run knows of the formation (DESIGN.md §3): its initial state,
+ * What one agent of a distributed run knows of the formation (doc/distributed.md): its initial state,
  * its neighbours, the checks of a neighbour's state message, and grad_i V from the positions it
  * holds, through Formation::agentGradient exactly as the centralised integrators call it.
  */
@@ -32,7 +32,7 @@ class AgentNeighbourhood {
                    const std::vector<double>& previousPosition) const;
 
   /**
-   * grad_i V(q) (DESIGN.md §1) from the agent's own q_i and the neighbours' positions.
+   * grad_i V(q) (doc/maths.md §2) from the agent's own q_i and the neighbours' positions.
    * @param own d doubles. @param neighbourPosition(j) d doubles of neighbour j.
    * @param out d doubles.
    */

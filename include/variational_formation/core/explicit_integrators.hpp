@@ -8,42 +8,44 @@ namespace vf {
 class FirstOrderIntegrator : public Integrator {
  public:
   const Positions& positions() const override { return q_; }
-  Positions velocities() const override { return v_; }
-  Positions momenta() const override { return v_; }
+  Velocities velocities() const override { return v_; }
+  Momenta momenta() const override { return v_; }
   double energy() const override;
 
- protected:
-  FirstOrderIntegrator(const Formation& formation, const Positions& q0, const Positions& v0,
+  /// @param q0 [m], @param v0 [m/s], d x n each; @param timeStep h [s]; @param dampingGain
+  /// kappa [1/s]. Public so that each scheme inherits it; the class stays abstract (step()).
+  FirstOrderIntegrator(const Formation& formation, const Positions& q0, const Velocities& v0,
                        double timeStep, double dampingGain);
+
+ protected:
   /// a = -kappa v - grad V(q).
-  void acceleration(const Positions& q, const Positions& v, Positions& out) const;
+  void acceleration(const Positions& q, const Velocities& v, Accelerations& out) const;
 
   Positions q_;
-  Positions v_;
+  Velocities v_;
 };
 
 /// Explicit Euler on (q, v): the paper's comparison (Section 6.1).
 class ExplicitEulerIntegrator : public FirstOrderIntegrator {
  public:
-  ExplicitEulerIntegrator(const Formation& formation, const Positions& q0, const Positions& v0,
-                          double timeStep, double dampingGain)
-      : FirstOrderIntegrator(formation, q0, v0, timeStep, dampingGain) {}
+  using FirstOrderIntegrator::FirstOrderIntegrator;
   void step() override;
 
  private:
-  Positions a_;
+  Accelerations a_;
 };
 
 /// Classical fourth-order Runge-Kutta on (q, v): the accuracy baseline.
 class RungeKutta4Integrator : public FirstOrderIntegrator {
  public:
-  RungeKutta4Integrator(const Formation& formation, const Positions& q0, const Positions& v0,
-                        double timeStep, double dampingGain)
-      : FirstOrderIntegrator(formation, q0, v0, timeStep, dampingGain) {}
+  using FirstOrderIntegrator::FirstOrderIntegrator;
   void step() override;
 
  private:
-  Positions k1q_, k1v_, k2q_, k2v_, k3q_, k3v_, k4q_, k4v_, qs_, vs_;
+  // Stage slopes: k*q_ are velocities, k*v_ accelerations; qs_, vs_ the stage state.
+  Velocities k1q_, k2q_, k3q_, k4q_, vs_;
+  Accelerations k1v_, k2v_, k3v_, k4v_;
+  Positions qs_;
 };
 
 }  // namespace vf

@@ -44,20 +44,20 @@ class Formation {
   const std::vector<Neighbour>& neighbours(int agent) const { return neighbours_[agent]; }
   const Positions& desiredShape() const { return desiredShape_; }
 
-  /// V(q), DESIGN.md §1.
+  /// V(q), doc/maths.md §1.
   double potential(const Positions& q) const;
   /// 1/2 sum_{j in N_i} V_ij(q): each edge's potential split half to each endpoint.
   double agentPotential(int agent, const Positions& q) const;
 
   /**
-   * grad_i V = sum_{j in N_i} (|q_i - q_j|^2 - d_ij^2)(q_i - q_j) (DESIGN.md §1; the paper's
+   * grad_i V = sum_{j in N_i} (|q_i - q_j|^2 - d_ij^2)(q_i - q_j) (doc/maths.md §1; the paper's
    * Gamma_ij with its erratum fixed). Reads only column i and the columns of N_i, so the
    * agent node and the centralised run call this very function on the same numbers.
    * @param out d doubles.
    */
   void agentGradient(int agent, const Positions& q, double* out) const;
   /// Stacked gradient, d x n, agent by agent through agentGradient.
-  void gradient(const Positions& q, Positions& out) const;
+  void gradient(const Positions& q, Gradients& out) const;
   /// Hessian of V, (dn) x (dn), with agent i in rows/columns [d i, d i + d).
   Eigen::MatrixXd hessian(const Positions& q) const;
 
@@ -79,7 +79,7 @@ class Formation {
    * Congruence (paper Section 6.2): every pairwise distance, over all pairs, is within
    * tolerance (relative) of the desired shape's and every agent's speed is below maxSpeed.
    */
-  bool isCongruent(const Positions& q, const Positions& v, double tolerance = 0.01,
+  bool isCongruent(const Positions& q, const Velocities& v, double tolerance = 0.01,
                    double maxSpeed = 0.1) const;
 
  private:

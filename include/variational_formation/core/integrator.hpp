@@ -13,7 +13,6 @@ enum class Method { Variational, ExplicitEuler, RungeKutta4 };
 
 /// "vi", "euler", "rk4" -> Method. @throws InvalidInput naming `field`.
 Method parseMethod(const std::string& text, const std::string& field = "--method");
-std::string methodName(Method method);
 /// "variational", "paper" -> StartMethod. @throws InvalidInput naming `field`.
 StartMethod parseStartMethod(const std::string& text, const std::string& field = "--init");
 
@@ -30,9 +29,9 @@ class Integrator {
   /// q_k, d x n.
   virtual const Positions& positions() const = 0;
   /// Velocity at step k: v_{k-1} = (q_k - q_{k-1})/h for the variational scheme (v_0 at k = 0).
-  virtual Positions velocities() const = 0;
+  virtual Velocities velocities() const = 0;
   /// Unweighted momentum at step k: p+_k for the variational scheme (v_0 at k = 0), v_k else.
-  virtual Positions momenta() const = 0;
+  virtual Momenta momenta() const = 0;
   /// Energy at step k: the discrete energy E_d(q_{k-1}, q_k) for the variational scheme,
   /// 1/2|v|^2 + V(q) otherwise (and at k = 0).
   virtual double energy() const = 0;
@@ -40,7 +39,6 @@ class Integrator {
   long stepIndex() const { return step_; }
   double time() const { return static_cast<double>(step_) * timeStep_; }
   double timeStep() const { return timeStep_; }
-  double dampingGain() const { return dampingGain_; }
   const Formation& formation() const { return formation_; }
 
  protected:
@@ -61,7 +59,7 @@ class Integrator {
  * @throws InvalidInput on bad sizes or values (h and kappa: validateDynamics, validation.hpp).
  */
 std::unique_ptr<Integrator> makeIntegrator(Method method, const Formation& formation,
-                                           const Positions& q0, const Positions& v0,
+                                           const Positions& q0, const Velocities& v0,
                                            double timeStep, double dampingGain,
                                            StartMethod start = StartMethod::Variational);
 

@@ -9,7 +9,7 @@
 namespace vf {
 
 /**
- * One agent of the distributed lockstep run (DESIGN.md §3), without any transport: it holds
+ * One agent of the distributed lockstep run (doc/distributed.md), without any transport: it holds
  * q_{k-1}, q_k of its own and the latest state of each neighbour, and computes q_{k+1} once
  * it holds every neighbour's q_k. It calls Formation::agentGradient and variationalUpdate /
  * variationalStart exactly as VariationalIntegrator does, so the distributed trajectory equals

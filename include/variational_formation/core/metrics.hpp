@@ -6,22 +6,22 @@
 namespace vf {
 
 /**
- * Discrete momenta, energy and Noether quantities of DESIGN.md §1. All momenta are the
+ * Discrete momenta, energy and Noether quantities of doc/maths.md §4-6. All momenta are the
  * unweighted ones (divided by e^{kappa t}), so none of these ever forms e^{kappa t}.
  */
 
 /// p+_{k+1} = ((1 + e^{-kappa h})/2) v_k - (h/2) grad V(q_{k+1}), v_k = (q_{k+1} - q_k)/h.
-Positions discreteMomentumPlus(const Formation& formation, const VariationalCoefficients& c,
+Momenta discreteMomentumPlus(const Formation& formation, const VariationalCoefficients& c,
                                const Positions& qk, const Positions& qk1);
 /// p-_k = ((1 + e^{kappa h})/2) v_k + (h/2) grad V(q_k).
-Positions discreteMomentumMinus(const Formation& formation, const VariationalCoefficients& c,
+Momenta discreteMomentumMinus(const Formation& formation, const VariationalCoefficients& c,
                                 const Positions& qk, const Positions& qk1);
 
 /// The discrete Hamiltonian flow (q_k, p_k) -> (q_{k+1}, p_{k+1}) (paper Section 4): solves
 /// p_k = p-_k(q_k, q_{k+1}) for q_{k+1} (explicit here) and returns p+_{k+1}.
 void discreteHamiltonianFlow(const Formation& formation, const VariationalCoefficients& c,
-                             const Positions& qk, const Positions& pk, Positions& qk1,
-                             Positions& pk1);
+                             const Positions& qk, const Momenta& pk, Positions& qk1,
+                             Momenta& pk1);
 
 /// E_d(q_k, q_{k+1}) = 1/2 |v_k|^2 + 1/2 (V(q_k) + V(q_{k+1})).
 double discreteEnergy(const Formation& formation, double timeStep, const Positions& qk,
@@ -30,17 +30,17 @@ double discreteEnergy(const Formation& formation, double timeStep, const Positio
 Eigen::VectorXd agentDiscreteEnergy(const Formation& formation, double timeStep,
                                     const Positions& qk, const Positions& qk1);
 /// E = 1/2 |v|^2 + V(q).
-double continuousEnergy(const Formation& formation, const Positions& q, const Positions& v);
+double continuousEnergy(const Formation& formation, const Positions& q, const Velocities& v);
 /// Per agent 1/2 |v_i|^2 + V_i(q).
 Eigen::VectorXd agentContinuousEnergy(const Formation& formation, const Positions& q,
-                                      const Positions& v);
+                                      const Velocities& v);
 
 /// P = sum_i p_i (z = 0 in 2D).
-Vector3 linearMomentum(const Positions& p);
+Vector3 linearMomentum(const Momenta& p);
 /// A = sum_i q_i x p_i (in 2D, only z is nonzero).
-Vector3 angularMomentum(const Positions& q, const Positions& p);
+Vector3 angularMomentum(const Positions& q, const Momenta& p);
 
-/// Noether's prediction e^{-kappa t_k} X_0 = (e^{-kappa h})^k X_0 (DESIGN.md §1).
+/// Noether's prediction e^{-kappa t_k} X_0 = (e^{-kappa h})^k X_0 (doc/maths.md §6).
 Vector3 noetherPrediction(const Vector3& initial, const VariationalCoefficients& c, long step);
 
 /// |X - prediction| / max(|X_0|, 1e-300): the residual the Noether tests bound.

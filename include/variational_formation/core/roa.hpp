@@ -42,7 +42,7 @@ struct RoaCell {
 /**
  * Region-of-attraction campaign: one simulation per grid point, agent `grid.agent` starting
  * there at rest and every other agent at rest at its desired position; each run is the
- * variational integrator with the variational start. Congruence (DESIGN.md §1) is checked at
+ * variational integrator with the variational start. Congruence (doc/maths.md §8) is checked at
  * every step with v_k = (q_k - q_{k-1})/h.
  *
  * Two paths compute the same thing: simulateCell (one simulation over the core's

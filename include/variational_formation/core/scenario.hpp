@@ -9,7 +9,7 @@
 namespace vf {
 
 /**
- * One scenario file (DESIGN.md §4). Loaded and checked by one path, shared by the CLIs and the
+ * One scenario file (doc/architecture.md, file formats). Loaded and checked by one path, shared by the CLIs and the
  * nodes. Positions are d x n, agents in id order.
  */
 struct Scenario {
@@ -19,7 +19,7 @@ struct Scenario {
   double timeStep = 0.0;     ///< h [s]
   long steps = 0;            ///< number of updates; 0 = unbounded (ROS run only)
   Positions initialPositions;
-  Positions initialVelocities;
+  Velocities initialVelocities;
   Positions desiredPositions;
   std::vector<std::pair<int, int>> edges;
   /// Non-fatal findings, one line each (a non-rigid desired graph, a too large h).

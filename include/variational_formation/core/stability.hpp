@@ -11,7 +11,7 @@ namespace vf {
 double maxStiffnessFrequency(const Formation& formation, const Positions& q);
 
 /**
- * Linear stability limit of the variational update for a mode of frequency w (DESIGN.md §1):
+ * Linear stability limit of the variational update for a mode of frequency w (doc/maths.md §7):
  * stable iff h w < 2 cosh(kappa h / 2). Returns the smallest h > 0 with h w = 2 cosh(kappa h/2),
  * or +infinity if there is none (strong damping: every h is linearly stable).
  */

@@ -4,30 +4,29 @@
 
 namespace vf {
 
-/// The centralised explicit variational integrator (DESIGN.md §1), agent by agent.
+/// The centralised explicit variational integrator (doc/maths.md §2), agent by agent.
 class VariationalIntegrator : public Integrator {
  public:
-  VariationalIntegrator(const Formation& formation, const Positions& q0, const Positions& v0,
+  VariationalIntegrator(const Formation& formation, const Positions& q0, const Velocities& v0,
                         double timeStep, double dampingGain, StartMethod start);
 
   void step() override;
   const Positions& positions() const override { return q_; }
-  Positions velocities() const override;
-  Positions momenta() const override;
+  Velocities velocities() const override;
+  Momenta momenta() const override;
   double energy() const override;
 
   /// q_{k-1} (q_0 at k = 0).
   const Positions& previousPositions() const { return qPrev_; }
-  const VariationalCoefficients& coefficients() const { return coefficients_; }
 
  private:
   VariationalCoefficients coefficients_;
   StartMethod start_;
-  Positions v0_;
+  Velocities v0_;
   Positions qPrev_;
   Positions q_;
   Positions qNext_;
-  Positions gradient_;
+  Gradients gradient_;
 };
 
 }  // namespace vf

@@ -4,7 +4,7 @@ namespace vf {
 
 /**
  * Constant coefficients of the explicit variational update for L = e^{kappa t}(1/2|q'|^2 - V),
- * DESIGN.md §1. They depend on h and kappa only through e^{+-kappa h}: e^{kappa t} is never
+ * doc/maths.md §2. They depend on h and kappa only through e^{+-kappa h}: e^{kappa t} is never
  * formed, so long runs cannot overflow.
  */
 struct VariationalCoefficients {
@@ -24,7 +24,7 @@ struct VariationalCoefficients {
 };
 
 /**
- * One agent's explicit update (DESIGN.md §1; paper eq. (integrator-explicit), errata fixed):
+ * One agent's explicit update (doc/maths.md §2; paper eq. (integrator-explicit), errata fixed):
  * q_{k+2} = (1 + e^{-kappa h}) q_{k+1} - e^{-kappa h} q_k - 2h^2/(1 + e^{kappa h}) grad_i V(q_{k+1}).
  * Both the agent node and the centralised integrator call this function, coordinate by
  * coordinate, so the two paths agree bit for bit.
@@ -39,7 +39,7 @@ inline void variationalUpdate(const VariationalCoefficients& c, int dimension, c
 }
 
 /**
- * Variational start (DESIGN.md §1): solves p_0 = -D1 L_d^0(q_0, q_1) with p_0 = v_0,
+ * Variational start (doc/maths.md §3): solves p_0 = -D1 L_d^0(q_0, q_1) with p_0 = v_0,
  * q_1 = q_0 + 2h/(1 + e^{kappa h}) (v_0 - h/2 grad V(q_0)). Second order overall.
  */
 inline void variationalStart(const VariationalCoefficients& c, int dimension, const double* q0,
@@ -58,7 +58,7 @@ inline void paperStart(const VariationalCoefficients& c, int dimension, const do
 }
 
 /**
- * Velocity form of the explicit update (DESIGN.md §1), for an agent that measures its position:
+ * Velocity form of the explicit update (doc/maths.md §2), for an agent that measures its position:
  * v_{k+1} = e^{-kappa h} v_k - 2h/(1 + e^{kappa h}) grad_i V(q_{k+1}), then q_{k+2} = q_{k+1} + h v_{k+1}.
  * Equal to variationalUpdate up to round-off when v_k = (q_{k+1} - q_k)/h.
  * @param v v_k [m/s]. @param gradient grad_i V(q_{k+1}). @param vNext receives v_{k+1}; d doubles.
@@ -81,7 +81,7 @@ inline void variationalStep(const VariationalCoefficients& c, StartMethod start,
                             int dimension, const double* qPrev, const double* q, const double* v0,
                             const double* gradient, double* qNext) {
   if (step > 0) {
-    // DESIGN.md §1 explicit update; paper eq. (integrator-explicit), errata fixed.
+    // doc/maths.md §2, explicit update; paper eq. (integrator-explicit), errata fixed.
     variationalUpdate(c, dimension, qPrev, q, gradient, qNext);
   } else if (start == StartMethod::Variational) {
     variationalStart(c, dimension, q, v0, gradient, qNext);

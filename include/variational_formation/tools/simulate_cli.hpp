@@ -8,7 +8,7 @@ namespace vf {
 enum ExitStatus { kExitOk = 0, kExitFailure = 1, kExitBadInput = 2 };
 
 /**
- * The `simulate` tool (DESIGN.md §4): runs a scenario centrally and writes traj.csv and,
+ * The `simulate` tool (doc/architecture.md, file formats): runs a scenario centrally and writes traj.csv and,
  * optionally, metrics.csv. Bad input is one line on err and kExitBadInput.
  */
 int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::ostream& err);

@@ -1,4 +1,4 @@
-"""Plots of a formation run, shared by the CSV (plot_simulation.py) and bag front-ends.
+"""Plots of a formation run, shared by the CSV (plot_simulation.py) and bag (plot_bag.py) front-ends.
 
 Every function takes plain numpy arrays:
   t[k]            time of step k [s]
@@ -8,54 +8,16 @@ Every function takes plain numpy arrays:
   p[k, 3], a[k, 3] total linear and angular momentum
 """
 import os
-import sys
-import types
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-import yaml  # noqa: E402
-
-
-def fail(message):
-    """One line on stderr, named after the running script, and exit status 2."""
-    program = os.path.splitext(os.path.basename(sys.argv[0]))[0]
-    print(f"{program}: error: {' '.join(str(message).split())}", file=sys.stderr)
-    sys.exit(2)
-
-
-def load_csv(path, header):
-    """The rows of a CSV file whose first line must be `header`, as a 2D array; fail() if not."""
-    try:
-        with open(path) as f:
-            first = f.readline().strip()
-        if first != header:
-            fail(f"{path}: expected header '{header}', got '{first}'")
-        return np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
-    except (OSError, ValueError) as e:
-        fail(f"{path}: {e}")
-
-
-def read_scenario(path):
-    """The fields of a scenario file (already checked by the package's loader) that the plots
-    use: name, dimension, kappa, time_step, n, desired (n x d array) and edges."""
-    try:
-        with open(path) as f:
-            s = yaml.safe_load(f)
-        agents = s["agents"]
-        return types.SimpleNamespace(
-            name=str(s.get("name", "")), dimension=int(s["dimension"]), kappa=float(s["kappa"]),
-            time_step=float(s["time_step"]), n=len(agents),
-            desired=np.array([a["desired_position"] for a in agents], float),
-            edges=[tuple(e) for e in s.get("edges") or []])
-    except (OSError, yaml.YAMLError, KeyError, TypeError, ValueError, AttributeError) as e:
-        fail(f"{path}: cannot read the scenario ({e})")
 
 
 def noether_prediction(initial, kappa, h, steps):
-    """e^{-kappa t_k} X_0, formed as (e^{-kappa h})^k (DESIGN.md §1: never e^{kappa t})."""
+    """e^{-kappa t_k} X_0, formed as (e^{-kappa h})^k (doc/maths.md: never e^{kappa t})."""
     return np.power(np.exp(-kappa * h), steps)[:, None] * initial[None, :]
 
 
@@ -166,3 +128,81 @@ def summary(t, energy, error, p, a, kappa, h):
         f"Noether residual max_k |P_k - e^(-kappa t_k) P_0| / max(|P_0|, 1): {res_p.max() / scale_p:.3e}",
         f"Noether residual max_k |A_k - e^(-kappa t_k) A_0| / max(|A_0|, 1): {res_a.max() / scale_a:.3e}",
     ])
+
+
+def plot_region_of_attraction(path, cells, scenario, agent, h):
+    """Heatmap of roa.csv rows `cells` (ix, iy, x, y, converged, converged_step, diverged):
+    convergence time in colour, not converged grey, diverged black, the desired shape on top."""
+    from matplotlib.colors import ListedColormap
+
+    desired = scenario.desired
+    ix, iy = cells[:, 0].astype(int), cells[:, 1].astype(int)
+    nx, ny = ix.max() + 1, iy.max() + 1
+    time = np.full((ny, nx), np.nan)
+    status = np.zeros((ny, nx))  # 0 converged, 1 not converged, 2 diverged
+    conv = cells[:, 4] == 1
+    time[iy[conv], ix[conv]] = cells[conv, 5] * h
+    status[iy[~conv], ix[~conv]] = 1
+    status[iy[cells[:, 6] == 1], ix[cells[:, 6] == 1]] = 2
+    x, y = cells[:, 2], cells[:, 3]
+    dx = (x.max() - x.min()) / max(nx - 1, 1) or 1.0
+    dy = (y.max() - y.min()) / max(ny - 1, 1) or 1.0
+    extent = [x.min() - dx / 2, x.max() + dx / 2, y.min() - dy / 2, y.max() + dy / 2]
+
+    fig, ax = plt.subplots(figsize=(7, 6))
+    background = np.where(status == 0, np.nan, status)
+    ax.imshow(background, origin="lower", extent=extent, cmap=ListedColormap(["0.8", "black"]),
+              vmin=1, vmax=2, interpolation="nearest", aspect="equal")
+    image = ax.imshow(time, origin="lower", extent=extent, cmap="viridis", interpolation="nearest",
+                      aspect="equal")
+    fig.colorbar(image, ax=ax, label="convergence time [s]")
+    for i, j in scenario.edges:
+        ax.plot(desired[[i, j], 0], desired[[i, j], 1], color="white", lw=1.5)
+        ax.plot(desired[[i, j], 0], desired[[i, j], 1], color="red", lw=0.8)
+    ax.plot(desired[:, 0], desired[:, 1], "o", color="red", ms=5)
+    ax.plot(*desired[agent, :2], "o", mfc="none", mec="white", ms=12, mew=2)
+    ax.set_xlim(extent[0], extent[1])
+    ax.set_ylim(extent[2], extent[3])
+    ax.set_xlabel("x of agent %d at start [m]" % agent)
+    ax.set_ylabel("y of agent %d at start [m]" % agent)
+    ax.set_title(f"{scenario.name}: region of attraction of agent {agent}\n"
+                 f"{len(cells)} cells: {100 * conv.mean():.1f}% converged (colour), "
+                 f"{100 * (status == 1).mean():.1f}% not (grey), "
+                 f"{100 * (status == 2).mean():.1f}% diverged (black)", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def plot_method_comparison(path, title, runs, dimension):
+    """One row per method: each run's trajectories (x = start; points beyond 1e3 m left out)
+    and, last, E / E_0 of every run of that method. `runs` holds, in rows of equal length,
+    (method label, h, q[k, i, 0:3], t, energy, bounded)."""
+    labels = list(dict.fromkeys(r[0] for r in runs))
+    columns = len(runs) // len(labels)
+    fig = plt.figure(figsize=(4 * (columns + 1), 3.75 * len(labels)))
+    for r, label in enumerate(labels):
+        mine = [run for run in runs if run[0] == label]
+        energy_ax = fig.add_subplot(len(labels), columns + 1, r * (columns + 1) + columns + 1)
+        for c, (_, h, q, t, energy, bounded) in enumerate(mine):
+            ax = fig.add_subplot(len(labels), columns + 1, r * (columns + 1) + c + 1,
+                                 projection="3d" if dimension == 3 else None)
+            for i in range(q.shape[1]):
+                ok = np.all(np.isfinite(q[:, i]), axis=1) & (np.abs(q[:, i]).max(axis=1) < 1e3)
+                track = [q[ok, i, a] for a in range(dimension)]
+                line, = ax.plot(*track, lw=1)
+                ax.plot(*[[q[0, i, a]] for a in range(dimension)], "x", color=line.get_color())
+            ax.set_title(f"{label}, h = {h}" + ("" if bounded else " (diverged)"), fontsize=9)
+            if dimension == 2:
+                ax.set_aspect("equal", adjustable="datalim")
+            good = np.isfinite(energy) & (energy > 0)
+            energy_ax.semilogy(t[good], energy[good] / energy[0], label=f"h = {h}")
+        energy_ax.set_title(f"{label}: E / E_0", fontsize=9)
+        energy_ax.set_xlabel("t [s]")
+        energy_ax.set_ylim(1e-12, 1e3)
+        energy_ax.legend(fontsize="small")
+        energy_ax.grid(True, which="both", alpha=0.3)
+    fig.suptitle(f"{title} (x = start)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
