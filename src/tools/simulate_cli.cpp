@@ -38,7 +38,7 @@ bool parseDelayFlags(const Arguments& args, Method method, DelaySettings& delay)
   }
   if (method != Method::Variational) {
     throw InvalidInput(std::string(args.has("--loss") ? "--loss" : "--delay-steps") +
-                       ": only with --method vi, got --method " + methodName(method));
+                       ": only with --method vi, got --method " + args.text("--method"));
   }
   if (args.has("--delay-steps")) delay.delaySteps = args.integer("--delay-steps", 0, 1000000);
   if (args.has("--loss")) {
