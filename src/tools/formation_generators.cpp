@@ -5,6 +5,7 @@
 #include <numeric>
 #include <random>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -14,9 +15,15 @@ namespace vf {
 
 namespace {
 
+std::string text(double x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+
 void requireSpacing(double spacing) {
   if (!(std::isfinite(spacing) && spacing > 0.0)) {
-    throw InvalidInput("--spacing: must be finite and > 0");
+    throw InvalidInput("--spacing: must be finite and > 0, got " + text(spacing));
   }
 }
 
@@ -182,7 +189,7 @@ FormationGraph hennebergConstruction(int agents, int dimension, std::uint64_t se
 
 Positions perturbedPositions(const Positions& desired, double sigma, std::uint64_t seed) {
   if (!(std::isfinite(sigma) && sigma >= 0.0)) {
-    throw InvalidInput("--perturb: must be finite and >= 0");
+    throw InvalidInput("--perturb: must be finite and >= 0, got " + text(sigma));
   }
   std::mt19937_64 engine(seed);
   Positions q = desired;

@@ -192,6 +192,8 @@ TEST(MakeScenario, PerturbationIsSeededUniformOfTheStatedSize) {
   EXPECT_EQ(perturbedPositions(desired, sigma, 7), perturbedPositions(desired, sigma, 7));
   EXPECT_NE(perturbedPositions(desired, sigma, 7), perturbedPositions(desired, sigma, 8));
   EXPECT_EQ(perturbedPositions(desired, 0.0, 7), desired);
+  EXPECT_THROW(perturbedPositions(desired, -0.1, 7), InvalidInput);
+  EXPECT_THROW(perturbedPositions(desired, NAN, 7), InvalidInput);
 }
 
 TEST(MakeScenario, CliStartsAtThePerturbationOfItsSeed) {
