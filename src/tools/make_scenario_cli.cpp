@@ -1,5 +1,7 @@
 #include "variational_formation/tools/make_scenario_cli.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <iomanip>
 #include <limits>
@@ -200,9 +202,14 @@ int runMakeScenarioCli(int argc, const char* const* argv, std::ostream& out, std
     const Generated g = generate(args, shape, spacing, seed);
     Scenario s;
     s.name = args.text("--name", g.name);
+    // A YAML plain scalar that loads back as this string (not null, no flow punctuation).
+    std::string lower = s.name;
+    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
     if (s.name.empty() || s.name.find_first_of(":#{}[],&*!|>'\"%@`\n") != std::string::npos ||
-        s.name.front() == ' ' || s.name.front() == '-' || s.name.back() == ' ') {
-      throw InvalidInput("--name: must be a plain non-empty word, got '" + s.name + "'");
+        s.name.front() == ' ' || s.name.front() == '-' || s.name.back() == ' ' || lower == "null" ||
+        s.name == "~") {
+      throw InvalidInput("--name: must be a plain non-empty word (none of :#{}[],&*!|>'\"%@` or null), got '" +
+                         s.name + "'");
     }
     s.dimension = g.graph.dimension;
     s.dampingGain = kDefaultDampingGain;

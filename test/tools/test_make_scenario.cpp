@@ -325,6 +325,7 @@ TEST(MakeScenario, BadArgumentsAreOneLineWithStatusTwo) {
       {ring({"--time-step", "0"}), "--time-step: must be > 0"},
       {ring({"--steps", "0"}), "--steps: must be between 1"},
       {ring({"--name", "a: b"}), "--name: must be a plain"},
+      {ring({"--name", "Null"}), "--name: must be a plain"},
       {ring({"--out", "/nonexistent/dir/s.yaml"}), "--out: cannot write"},
       {ring({"--bogus"}), "--bogus: unknown flag"},
       {ring({"--agents", "7"}), "--agents: given more than once"},
