@@ -1,8 +1,22 @@
 #!/usr/bin/env bash
-# Lockstep throughput of the distributed run: for 4, 6, 20 and 50 agents (a ring with the
-# chords to the second neighbour, h = 0.005, as fast as possible, no recording), prints the
-# steps per second and the real-time factor that the monitor measured from step 0 to the last.
-# usage: ./scripts/benchmark_ros.sh [agent counts...]
+# Throughput and cost of the distributed lockstep run, as one table: agent count x mode.
+#   process: one process per agent (formation.launch scenario:=FILE)
+#   nodelet: every agent in one nodelet manager (formation.launch scenario:=FILE nodelet:=true);
+#            n/a while the launch file has no `nodelet` argument or its launch fails.
+# Each run is a ring with chords to the second neighbour written by make_scenario (spacing 1 m,
+# start perturbed by up to 0.05 m per coordinate, seed 1, kappa 2, h = 0.005 s), run as fast as
+# possible without recording, on its own ROS master (a free port in 11500-11599).
+# Columns:
+#   steps/s, real-time factor: the monitor's final line, from step 0 to the last step;
+#   CPU%/agent: CPU time of the processes hosting agents (`agent` and `nodelet` processes under
+#     the launch, from /proc every VF_BENCH_SAMPLE s) over the monitor's stepping window,
+#     divided by the window and the agent count (100 = one core);
+#   RSS MiB/agent: the largest total resident memory of those processes, divided by the agent
+#     count.
+# usage: ./scripts/benchmark_ros.sh [agent counts...]          (default 6 20 50 100 200)
+# environment: VF_BENCH_MODES (default "process nodelet"), VF_BENCH_STEPS (steps per run;
+#   default max(300, 60000 / agents), about 5-10 s per run), VF_BENCH_TIMEOUT (s per run,
+#   default 900), VF_BENCH_SAMPLE (s between samples, default 0.5).
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 vf_install_dependencies
 vf_build
@@ -10,30 +24,126 @@ vf_source
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 counts=("$@")
-[ ${#counts[@]} -eq 0 ] && counts=(4 6 20 50)
-printf '%8s %8s %12s %16s\n' agents steps "steps/s" "real-time factor"
+[ ${#counts[@]} -eq 0 ] && counts=(6 20 50 100 200)
+read -r -a modes <<<"${VF_BENCH_MODES:-process nodelet}"
+timeout_s="${VF_BENCH_TIMEOUT:-900}"
+sample_s="${VF_BENCH_SAMPLE:-0.5}"
+monitor_line='monitor: [0-9]+ steps in'
+
+# A port in 11500-11599 that nothing listens on, starting from a different one per call.
+port_offset=$(( $$ % 100 ))
+free_port() {
+  local k p
+  for k in $(seq 0 99); do
+    p=$(( 11500 + (port_offset + k) % 100 ))
+    if ! (exec 3<>"/dev/tcp/127.0.0.1/$p") 2>/dev/null; then
+      port_offset=$(( (port_offset + k + 1) % 100 ))
+      echo "$p"
+      return 0
+    fi
+  done
+  echo "benchmark_ros: no free port in 11500-11599" >&2
+  return 1
+}
+
+# Every VF_BENCH_SAMPLE s until the launch ends or the monitor's final line is in the log:
+# "S <time>" then "P <pid> <utime+stime ticks> <rss KiB>" per agent-hosting process under
+# root; "E <time>" when it stops.
+sample_agents() {
+  local root="$1" log="$2" out="$3" page_kib pids
+  page_kib=$(( $(getconf PAGESIZE) / 1024 ))
+  while kill -0 "$root" 2>/dev/null && ! grep -qE "$monitor_line" "$log"; do
+    pids=$(ps -e -o pid=,ppid=,comm= | awk -v root="$root" '
+      { parent[$1] = $2; name[$1] = $3 }
+      END {
+        for (p in parent) {
+          q = p
+          while (q in parent && q != root && q > 1) q = parent[q]
+          if (q == root && p != root && name[p] ~ /^(agent|nodelet)$/) printf "/proc/%s/stat ", p
+        }
+      }')
+    echo "S $EPOCHREALTIME" >>"$out"
+    # shellcheck disable=SC2086
+    [ -n "$pids" ] && cat $pids 2>/dev/null | awk -v kib="$page_kib" '
+      { pid = $1; sub(/^.*\) /, ""); print "P", pid, $12 + $13, $22 * kib }' >>"$out"
+    sleep "$sample_s"
+  done
+  echo "E $EPOCHREALTIME" >>"$out"
+}
+
+# CPU%/agent and RSS MiB/agent from the samples, the stepping seconds, the agent count and
+# the wall time of the last step (the monitor line's time stamp; if empty, when sampling
+# stopped). The CPU window is the samples within the stepping seconds before that.
+summarise_samples() {
+  awk -v seconds="$2" -v n="$3" -v end="$4" -v hz="$(getconf CLK_TCK)" '
+    function flush() { if (k) { c = 0; for (p in ticks) c += ticks[p]; cum[k] = c } }
+    $1 == "S" { flush(); k++; t[k] = $2; rss[k] = 0; next }
+    $1 == "P" { ticks[$2] = $3; rss[k] += $4; next }
+    $1 == "E" && !end { end = $2 }
+    END {
+      flush()
+      peak = 0
+      for (i = 1; i <= k; i++) if (rss[i] > peak) peak = rss[i]
+      first = 0; last = 0
+      for (i = 1; i <= k; i++) {
+        if (end && t[i] >= end - seconds && !first) first = i
+        if (end && t[i] < end) last = i
+      }
+      cpu = "-"
+      if (first && last > first && t[last] - t[first] >= 0.25 * seconds) cpu = sprintf("%.1f", 100 * (cum[last] - cum[first]) / hz / (t[last] - t[first]) / n)
+      printf "%s %s\n", cpu, (peak > 0 ? sprintf("%.1f", peak / 1024 / n) : "-")
+    }' "$1"
+}
+
+mode_supported() {
+  [ "$1" = process ] && return 0
+  roslaunch --ros-args variational_formation formation.launch 2>/dev/null | grep -qE "^ +$1[ :(]"
+}
+
+declare -A skip
+for m in "${modes[@]}"; do
+  case "$m" in process|nodelet) ;; *) echo "benchmark_ros: VF_BENCH_MODES: unknown mode '$m' (process, nodelet)" >&2; exit 2 ;; esac
+  mode_supported "$m" || { skip[$m]=1; echo "benchmark_ros: formation.launch has no '$m' argument: $m is n/a" >&2; }
+done
+
+printf '%7s %-8s %7s %9s %17s %11s %14s\n' agents mode steps "steps/s" "real-time factor" "CPU%/agent" "RSS MiB/agent"
 for n in "${counts[@]}"; do
-  steps=$(( n <= 6 ? 3000 : (n <= 20 ? 1500 : 600) ))
-  /usr/bin/python3 - "$n" "$steps" >"$tmp/ring$n.yaml" <<'PY'
-import math, sys
-n, steps = int(sys.argv[1]), int(sys.argv[2])
-r = n / (2 * math.pi)  # unit sides
-print(f"name: ring{n}\ndimension: 2\nkappa: 2.0\ntime_step: 0.005\nsteps: {steps}\nagents:")
-for i in range(n):
-    a = 2 * math.pi * i / n
-    x, y = r * math.cos(a), r * math.sin(a)
-    print(f"  - {{id: {i}, initial_position: [{x * 1.05!r}, {y * 0.97!r}], desired_position: [{x!r}, {y!r}]}}")
-edges = [[i, (i + k) % n] for i in range(n) for k in (1, 2) if n > 2 * k or (k == 1)]
-seen, unique = set(), []
-for i, j in edges:
-    if (min(i, j), max(i, j)) not in seen and i != j:
-        seen.add((min(i, j), max(i, j)))
-        unique.append([i, j])
-print(f"edges: {unique}")
-PY
-  roslaunch variational_formation formation.launch scenario:="$tmp/ring$n.yaml" >"$tmp/log$n" 2>&1 || true
-  line=$(grep -E "monitor: [0-9]+ steps in" "$tmp/log$n" | sed -E 's/\x1b\[[0-9;]*m//g')
-  rate=$(echo "$line" | sed -nE 's/.*: ([0-9]+) steps\/s.*/\1/p')
-  rtf=$(echo "$line" | sed -nE 's/.*real-time factor ([0-9.]+).*/\1/p')
-  printf '%8s %8s %12s %16s\n' "$n" "$steps" "${rate:-failed}" "${rtf:-failed}"
+  steps="${VF_BENCH_STEPS:-$(( 60000 / n > 300 ? 60000 / n : 300 ))}"
+  scenario="$tmp/ring$n.yaml"
+  rosrun variational_formation make_scenario --shape ring --agents "$n" --perturb 0.05 --seed 1 \
+    --steps "$steps" --name "ring$n" --out "$scenario"
+  for m in "${modes[@]}"; do
+    if [ -n "${skip[$m]:-}" ]; then
+      printf '%7s %-8s %7s %9s %17s %11s %14s\n' "$n" "$m" "$steps" n/a n/a n/a n/a
+      continue
+    fi
+    port="$(free_port)"
+    log="$tmp/log_${m}_$n" samples="$tmp/samples_${m}_$n"
+    : >"$samples"
+    extra=()
+    [ "$m" = nodelet ] && extra=(nodelet:=true)
+    ROS_MASTER_URI="http://localhost:$port" ROS_LOG_DIR="$tmp/ros_log" \
+      timeout -s INT -k 30 "$timeout_s" \
+      roslaunch -p "$port" variational_formation formation.launch scenario:="$scenario" "${extra[@]}" \
+      >"$log" 2>&1 &
+    launch=$!
+    sample_agents "$launch" "$log" "$samples" &
+    sampler=$!
+    wait "$launch" || true
+    wait "$sampler" || true
+    line=$(grep -E "$monitor_line" "$log" | sed -E 's/\x1b\[[0-9;]*m//g' | tail -n 1 || true)
+    rate=$(echo "$line" | sed -nE 's/.*: ([0-9]+) steps\/s.*/\1/p')
+    rtf=$(echo "$line" | sed -nE 's/.*real-time factor ([0-9.]+).*/\1/p')
+    seconds=$(echo "$line" | sed -nE 's/.* steps in ([0-9.]+) s.*/\1/p')
+    ended=$(echo "$line" | sed -nE 's/.*\[([0-9]+\.[0-9]+)\]: monitor: .*/\1/p')
+    if [ -z "$rate" ]; then
+      reason=$(sed -E 's/\x1b\[[0-9;]*m//g' "$log" | grep -iE 'error|fatal|exited|timeout' | tail -n 1 || true)
+      echo "benchmark_ros: $m, $n agents: no monitor line, so $m is n/a from here (${reason:-see the launch output})" >&2
+      skip[$m]=1
+      printf '%7s %-8s %7s %9s %17s %11s %14s\n' "$n" "$m" "$steps" n/a n/a n/a n/a
+      continue
+    fi
+    read -r cpu rss < <(summarise_samples "$samples" "$seconds" "$n" "$ended")
+    printf '%7s %-8s %7s %9s %17s %11s %14s\n' "$n" "$m" "$steps" "$rate" "$rtf" "$cpu" "$rss"
+  done
 done
