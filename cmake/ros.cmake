@@ -33,6 +33,12 @@ if(CATKIN_ENABLE_TESTING)
     separate_arguments(args UNIX_COMMAND "${case}")
     add_rostest(test/ros/distributed_run.test ARGS ${args})
   endforeach()
+  # Real faults (signals to the real processes) during recorded runs: test/ros/fault.test.
+  foreach(case "fault:=kill_agent seed:=3" "fault:=kill_agent_twice seed:=5" "fault:=kill_two seed:=2"
+               "fault:=stop_agent seed:=4" "fault:=kill_monitor seed:=6" "fault:=kill_recorder seed:=7")
+    separate_arguments(args UNIX_COMMAND "${case}")
+    add_rostest(test/ros/fault.test ARGS ${args})
+  endforeach()
   foreach(t two_formations launch)
     add_rostest(test/ros/${t}.test)
   endforeach()

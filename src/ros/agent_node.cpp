@@ -188,14 +188,17 @@ void AgentNode::recover() {
   std::vector<std::string> holders;
   for (int j : agent_->neighbourIds()) holders.push_back(agentNodeName(nh_, j));
   holders.push_back(monitor_);  // the fallback: it holds everyone's newest state
-  for (const std::string& holder : holders) {
-    RecallState call;
-    call.request.id = static_cast<uint32_t>(agent_->id());
-    if (!callWithTimeout(holder + "/recall", call, 2.0) || !call.response.held) continue;
-    if (call.response.step > best) {
-      best = call.response.step;
-      found = call.response;
-      from = holder;
+  std::vector<std::string> services;
+  for (const std::string& holder : holders) services.push_back(holder + "/recall");
+  std::vector<RecallState> calls(holders.size());
+  for (RecallState& call : calls) call.request.id = static_cast<uint32_t>(agent_->id());
+  const std::vector<bool> answered = callAllWithTimeout(services, calls, 2.0);
+  for (std::size_t k = 0; k < holders.size(); ++k) {
+    if (!answered[k] || !calls[k].response.held) continue;
+    if (calls[k].response.step > best) {
+      best = calls[k].response.step;
+      found = calls[k].response;
+      from = holders[k];
     }
   }
   if (best <= 0) {

@@ -94,8 +94,7 @@ void MonitorNode::onState(int agent, const ros::MessageEvent<AgentState const>& 
     return;
   } else {
     try {
-      const auto receipt =
-          monitor_->add(agent, msg.step, msg.position, msg.previous_position, progress_.allowed_step);
+      const auto receipt = monitor_->add(agent, msg.step, msg.position, msg.previous_position, acceptUpTo_);
       if (receipt == FormationMonitor::Receipt::Accepted || receipt == FormationMonitor::Receipt::Duplicate) {
         if (msg.step > newest_[static_cast<std::size_t>(agent)].step) newest_[static_cast<std::size_t>(agent)] = msg;
         owner.seen = true;
@@ -128,6 +127,7 @@ void MonitorNode::onRecorderProgress(const ros::MessageEvent<RunProgress const>&
     return;
   }
   recordedStep_ = std::max(recordedStep_, static_cast<long>(p.completed_step));
+  while (!unrecorded_.empty() && unrecorded_.front().first.step <= recordedStep_) unrecorded_.pop_front();
   recorderDone_ = p.state == RunProgress::FINISHED;
   updateProgress();
 }
@@ -153,6 +153,7 @@ void MonitorNode::publishCompleted() {
     visualization_msgs::MarkerArray markers = makeMarkers(s, monitor_->formation(), trails_);
     for (auto& m : markers.markers) m.header.stamp = stamp;
     markersPub_.publish(markers);
+    if (recording_) unrecorded_.push_back({status, markers});
     convergedStep_ = s.converged ? s.convergedStep : -1;
     congruentSinceAt_[s.metrics.step] = convergedStep_;
     if (s.converged && reportedConvergence_ != s.convergedStep) {
@@ -194,6 +195,7 @@ void MonitorNode::updateProgress() {
   if (next.state != progress_.state || next.allowed_step >= progress_.allowed_step + every ||
       (next.allowed_step > progress_.allowed_step && next.allowed_step == last)) {
     next.header.stamp.fromSec(std::max(0L, base) * monitor_->scenario().timeStep);
+    acceptUpTo_ = std::max(acceptUpTo_, static_cast<long>(next.allowed_step));
     const auto at = congruentSinceAt_.find(base);
     next.converged_step = at == congruentSinceAt_.end() ? -1 : at->second;
     congruentSinceAt_.erase(congruentSinceAt_.begin(), congruentSinceAt_.lower_bound(base));
@@ -237,10 +239,26 @@ void MonitorNode::watch() {
   const ros::WallTime since = lastCompletedAt_.isZero() ? startedAt_ : lastCompletedAt_;
   const double stalled = since.isZero() ? kCheckAfter : secondsSince(since);
   if (stalled >= kCheckAfter) {
-    for (int i : monitor_->missingAt(monitor_->nextStep())) {
+    const std::vector<int> missing = monitor_->missingAt(monitor_->nextStep());
+    for (int i : missing) {
       if (!checkAlive(agents_[static_cast<std::size_t>(i)], "agent_" + std::to_string(i), respawnTimeout_)) return;
     }
+    // A state published while a connection was coming up is lost to this subscriber, but the
+    // agent still holds it: catch up from the histories of the agents that are missing.
+    if (progress_.state != RunProgress::WAITING && !missing.empty()) {
+      const auto held = fetchHistories(missing);
+      for (std::size_t k = 0; k < missing.size(); ++k) addHistory(missing[k], held[k]);
+      publishCompleted();
+    }
     if (recording_ && !checkAlive(recorder_, "the recorder", 0.0)) return;
+    // A status published while the recorder's connection was coming up (after a restart of
+    // either) is lost to it: publish again what it has not recorded; it counts each step once.
+    if (recording_ && recordedStep_ < completedStep()) {
+      for (const auto& sm : unrecorded_) {
+        statusPub_.publish(sm.first);
+        markersPub_.publish(sm.second);
+      }
+    }
   }
   updateProgress();  // a viewer may have come
   if (stalled >= kReportEvery && secondsSince(lastReportAt_) >= kReportEvery) {
@@ -299,17 +317,38 @@ bool MonitorNode::onRecall(RecallState::Request& request, RecallState::Response&
   return true;
 }
 
+std::vector<RecallHistory::Response> MonitorNode::fetchHistories(const std::vector<int>& ids) {
+  std::vector<std::string> services;
+  for (int i : ids) services.push_back(agents_[static_cast<std::size_t>(i)].node + "/history");
+  std::vector<RecallHistory> calls(ids.size());
+  const std::vector<bool> answered = callAllWithTimeout(services, calls, 2.0);
+  std::vector<RecallHistory::Response> held(ids.size());
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    if (answered[k]) held[k] = calls[k].response;
+  }
+  return held;
+}
+
+void MonitorNode::addHistory(int agent, const RecallHistory::Response& held) {
+  for (const AgentState& s : held.states) {
+    if (monitor_->add(agent, s.step, s.position, s.previous_position, acceptUpTo_) ==
+            FormationMonitor::Receipt::Accepted &&
+        s.step > newest_[static_cast<std::size_t>(agent)].step) {
+      newest_[static_cast<std::size_t>(agent)] = s;
+    }
+  }
+}
+
 void MonitorNode::recover() {
   // A run in progress has agents that received a progress: ask every agent what it holds.
-  std::vector<RecallHistory::Response> held(agents_.size());
+  std::vector<int> all;
+  for (std::size_t i = 0; i < agents_.size(); ++i) all.push_back(static_cast<int>(i));
+  const std::vector<RecallHistory::Response> held = fetchHistories(all);
   long resumeAt = -1, since = -1;
-  for (std::size_t i = 0; i < agents_.size(); ++i) {
-    RecallHistory call;
-    if (!callWithTimeout(agents_[i].node + "/history", call, 2.0)) continue;
-    held[i] = call.response;
-    if (call.response.has_progress && call.response.progress.completed_step + 1 > resumeAt) {
-      resumeAt = call.response.progress.completed_step + 1;
-      since = call.response.progress.converged_step;
+  for (const auto& h : held) {
+    if (h.has_progress && h.progress.completed_step + 1 > resumeAt) {
+      resumeAt = h.progress.completed_step + 1;
+      since = h.progress.converged_step;
     }
   }
   if (resumeAt <= 0) return;  // a new run
@@ -318,14 +357,12 @@ void MonitorNode::recover() {
   firstStepAt_ = startedAt_ = ros::WallTime::now();
   progress_.state = RunProgress::RUNNING;
   progress_.completed_step = resumeAt - 1;
+  // The old monitor may have allowed up to its completed step (at most a quarter window past
+  // what the agents heard) plus the window.
+  acceptUpTo_ = resumeAt + window_ + window_ / 4;
   for (std::size_t i = 0; i < held.size(); ++i) {
-    for (const AgentState& s : held[i].states) {
-      progress_.allowed_step = std::max<long>(progress_.allowed_step, s.step);
-      if (s.step < resumeAt) continue;
-      monitor_->add(static_cast<long>(i), s.step, s.position, s.previous_position, s.step);
-      agents_[i].seen = true;
-      if (s.step > newest_[i].step) newest_[i] = s;
-    }
+    agents_[i].seen = true;
+    addHistory(static_cast<int>(i), held[i]);
   }
   ROS_INFO("monitor: resuming a run in progress at step %ld (rebuilt from the agents' histories)", resumeAt);
   lastCompletedAt_ = ros::WallTime::now();

@@ -5,6 +5,7 @@
 
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/service_call.hpp"
 
 namespace vf {
 
@@ -135,6 +136,39 @@ void RecorderNode::onState(int agent, const ros::MessageEvent<AgentState const>&
                       event.getPublisherName().c_str(), dropped_);
     return;
   }
+  record(agent, msg);
+}
+
+void RecorderNode::catchUp() {
+  // States published while a connection was coming up (an agent or the recorder restarted) are
+  // lost to this subscriber, but their agent still holds them: fetch them from its history.
+  if (progress_.state == RunProgress::FINISHED || progress_.state == RunProgress::FAILED) return;
+  if (progress_.completed_step != lastCatchUpStep_) {
+    lastCatchUpStep_ = progress_.completed_step;
+    stalledSince_ = ros::WallTime::now();
+    return;
+  }
+  if (secondsSince(stalledSince_) < 1.0) return;
+  std::vector<std::string> services;
+  std::vector<int> agents;
+  for (std::size_t i = 0; i < states_.size(); ++i) {
+    if (states_[i].next <= progress_.completed_step + 1) {
+      agents.push_back(static_cast<int>(i));
+      services.push_back(owners_[i] + "/history");
+    }
+  }
+  std::vector<RecallHistory> calls(services.size());
+  const std::vector<bool> answered = callAllWithTimeout(services, calls, 2.0);
+  for (std::size_t k = 0; k < agents.size(); ++k) {
+    if (!answered[k]) continue;
+    for (const AgentState& s : calls[k].response.states) {
+      if (s.step >= states_[static_cast<std::size_t>(agents[k])].next) record(agents[k], s);
+    }
+  }
+  stalledSince_ = ros::WallTime::now();
+}
+
+void RecorderNode::record(int agent, const AgentState& msg) {
   write(nh_.resolveName("agent_" + std::to_string(agent) + "/state"), msg, msg.header.stamp);
   if (!states_[static_cast<std::size_t>(agent)].add(msg.step)) {
     ++repeats_;  // a repeat is written as received; it must equal the first (doc/distributed.md)
@@ -204,6 +238,8 @@ void RecorderNode::close(const std::string& how) {
 
 int RecorderNode::run() {
   auto* queue = ros::getGlobalCallbackQueue();
+  stalledSince_ = ros::WallTime::now();
+  catchUpTimer_ = nh_.createWallTimer(ros::WallDuration(0.5), [this](const ros::WallTimerEvent&) { catchUp(); });
   while (ros::ok() && exitStatus_ < 0) queue->callAvailable(ros::WallDuration(0.1));
   close("interrupted");
   return exitStatus_ < 0 ? 0 : exitStatus_;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <ros/ros.h>
+#include <visualization_msgs/MarkerArray.h>
 
 #include "variational_formation/AgentState.h"
 #include "variational_formation/FormationStatus.h"
@@ -54,6 +55,8 @@ class MonitorNode {
     ros::WallTime goneSince;     // zero while alive
   };
   void recover();
+  std::vector<RecallHistory::Response> fetchHistories(const std::vector<int>& agents);
+  void addHistory(int agent, const RecallHistory::Response& held);
   bool onRecall(RecallState::Request& request, RecallState::Response& response);
   void onState(int agent, const ros::MessageEvent<AgentState const>& event);
   void onRecorderProgress(const ros::MessageEvent<RunProgress const>& event);
@@ -87,6 +90,9 @@ class MonitorNode {
   double respawnTimeout_ = 0.0;
   std::string resultFile_;
   RunProgress progress_;
+  long acceptUpTo_ = 0;
+  /// Published status and markers the recorder has not confirmed (at most a window of them).
+  std::deque<std::pair<FormationStatus, visualization_msgs::MarkerArray>> unrecorded_;  // states past this step cannot come yet (bounds the buffer)
   long dropped_ = 0;
   long reportedConvergence_ = -2;
   long convergedStep_ = -1;

@@ -10,6 +10,7 @@
 
 #include "variational_formation/AgentState.h"
 #include "variational_formation/FormationStatus.h"
+#include "variational_formation/RecallHistory.h"
 #include "variational_formation/RunProgress.h"
 #include "variational_formation/core/scenario.hpp"
 
@@ -17,6 +18,7 @@ namespace vf {
 
 using variational_formation::AgentState;
 using variational_formation::FormationStatus;
+using variational_formation::RecallHistory;
 using variational_formation::RunProgress;
 
 /**
@@ -54,6 +56,8 @@ class RecorderNode {
   template <typename M>
   void write(const std::string& topic, const M& msg, const ros::Time& stamp);
   void onState(int agent, const ros::MessageEvent<AgentState const>& event);
+  void record(int agent, const AgentState& msg);
+  void catchUp();
   void onStatus(const ros::MessageEvent<FormationStatus const>& event);
   void onMarkers(const ros::MessageEvent<visualization_msgs::MarkerArray const>& event);
   void onMonitorProgress(const ros::MessageEvent<RunProgress const>& event);
@@ -75,6 +79,9 @@ class RecorderNode {
   Steps status_;
   long markers_ = 0, written_ = 0, repeats_ = 0, dropped_ = 0;
   bool open_ = false;
+  ros::WallTimer catchUpTimer_;
+  ros::WallTime stalledSince_;
+  long lastCatchUpStep_ = -2;
   bool limited_ = false;  // the size limit ended the recording
   double splitBytes_ = 0.0, maxBytes_ = 0.0, closedBytes_ = 0.0;
   int part_ = 0;
