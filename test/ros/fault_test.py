@@ -23,11 +23,9 @@ import sys
 import threading
 import time
 import unittest
-import xmlrpc.client
 
 import math
 import rosbag
-import rosgraph
 import rospy
 import rostest
 from variational_formation.msg import AgentState, FormationStatus
@@ -38,15 +36,6 @@ import vf_rostest  # noqa: E402
 NS = "/formation"
 
 
-def node_pid(name, timeout=20.0):
-    master = rosgraph.Master("/fault_test")
-    end = time.time() + timeout
-    while time.time() < end:
-        try:
-            return xmlrpc.client.ServerProxy(master.lookupNode(name)).getPid("/fault_test")[2]
-        except Exception:
-            time.sleep(0.05)
-    raise AssertionError(f"{name} did not come up")
 
 
 class Watch:
@@ -110,6 +99,7 @@ class FaultRun(unittest.TestCase, vf_rostest.RunChecks):
             victim = rng.randrange(n)
             count = 2 if cls.fault == "kill_agent_twice" else cls.kills
             at = sorted(rng.sample(range(20, steps - 40), count))
+            # Kills one after another: each waits until the previous one has recovered.
             for step in at:
                 cls.inject(step, [victim], signal.SIGSTOP if cls.fault == "stop_agent" else signal.SIGKILL)
         elif cls.fault == "kill_two":
@@ -129,7 +119,7 @@ class FaultRun(unittest.TestCase, vf_rostest.RunChecks):
     def inject(cls, step, victims, sig):
         assert cls.watch.wait_for_step(step), f"the run never reached step {step}"
         names = [f"{NS}/agent_{v}" if isinstance(v, int) else f"{NS}/{v}" for v in victims]
-        pids = [node_pid(name) for name in names]
+        pids = [vf_rostest.node_pid(name) for name in names]
         before = {v: cls.watch.newest[v][0] for v in victims if isinstance(v, int)}
         for pid in pids:
             os.kill(pid, sig)
@@ -152,8 +142,13 @@ class FaultRun(unittest.TestCase, vf_rostest.RunChecks):
     @classmethod
     def tearDownClass(cls):
         if cls.recoveries:
-            print(f"fault_test: recovery after SIGKILL: median {statistics.median(cls.recoveries):.3f} s, "
-                  f"max {max(cls.recoveries):.3f} s over {len(cls.recoveries)} kills", flush=True)
+            line = (f"fault_test: recovery after SIGKILL: median {statistics.median(cls.recoveries):.3f} s, "
+                    f"max {max(cls.recoveries):.3f} s over {len(cls.recoveries)} kills")
+            print(line, flush=True)
+            stats = rospy.get_param("~stats_file", "")
+            if stats:
+                with open(stats, "w") as f:
+                    f.write(line + "\n")
         shutil.rmtree(cls.out, ignore_errors=True)
 
     def test_outcome_and_recording(self):

@@ -28,14 +28,12 @@ import sys
 import tempfile
 import time
 import unittest
-import xmlrpc.client
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.image  # noqa: E402
 import numpy as np  # noqa: E402
-import rosgraph  # noqa: E402
 import rospy  # noqa: E402
 import rostest  # noqa: E402
 import yaml  # noqa: E402
@@ -61,15 +59,6 @@ def start(cmd):
                             start_new_session=True)
 
 
-def node_pid(name, timeout=20.0):
-    master = rosgraph.Master("/launch_test")
-    end = time.time() + timeout
-    while time.time() < end:
-        try:
-            return xmlrpc.client.ServerProxy(master.lookupNode(name)).getPid("/launch_test")[2]
-        except Exception:
-            time.sleep(0.1)
-    raise AssertionError(f"{name} did not come up")
 
 
 class StepWatcher:
@@ -163,7 +152,7 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
         self.assertLess(ended_after, 15.0, "the launch took too long to end after the kill")
 
     def test_agent_killed_with_sigkill_fails_the_run_naming_it(self):
-        self.check_killed_agent_fails_the_run(lambda name: os.kill(node_pid(name), signal.SIGKILL),
+        self.check_killed_agent_fails_the_run(lambda name: os.kill(vf_rostest.node_pid(name), signal.SIGKILL),
                                               "/formation/agent_3")
 
     def test_agent_ended_with_rosnode_kill_fails_the_run_naming_it(self):
@@ -218,7 +207,7 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
                      f"output_dir:={out}"])
         try:
             self.assertTrue(watcher.wait_for(300), "the run did not start")
-            monitor = node_pid("/formation/monitor")
+            monitor = vf_rostest.node_pid("/formation/monitor")
             os.kill(monitor, signal.SIGSTOP)
             time.sleep(1.5)
             held = dict(steps)

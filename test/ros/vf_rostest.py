@@ -8,7 +8,10 @@ import subprocess
 import tempfile
 import time
 
+import xmlrpc.client
+
 import rosbag
+import rosgraph
 import rospkg
 import yaml
 
@@ -39,6 +42,18 @@ def simulate(path):
             rows = list(csv.DictReader(f))
     d = int(load_scenario(path)["dimension"])
     return {(int(r["agent"]), int(r["step"])): [float(r[c]) for c in "xyz"[:d]] for r in rows}
+
+
+def node_pid(name, timeout=20.0):
+    """The process id of a running node, asked of the node itself (as `rosnode info` does)."""
+    master = rosgraph.Master("/vf_rostest")
+    end = time.time() + timeout
+    while time.time() < end:
+        try:
+            return xmlrpc.client.ServerProxy(master.lookupNode(name)).getPid("/vf_rostest")[2]
+        except Exception:
+            time.sleep(0.05)
+    raise AssertionError(f"{name} did not come up")
 
 
 def wait_for_result(path, timeout):
