@@ -1,5 +1,7 @@
 #include "variational_formation/ros/recorder_node.hpp"
 
+#include <cmath>
+
 #include <ros/callback_queue.h>
 #include <tf2_msgs/TFMessage.h>
 
@@ -197,9 +199,9 @@ void RecorderNode::onStatus(const ros::MessageEvent<FormationStatus const>& even
 void RecorderNode::onMarkers(const ros::MessageEvent<visualization_msgs::MarkerArray const>& event) {
   if (!fromOwner(event, monitor_)) return;
   const auto& msg = *event.getConstMessage();
-  write(nh_.resolveName("markers"), msg, msg.markers.empty() ? ros::TIME_MIN : msg.markers[0].header.stamp);
-  ++markers_;
-  report();
+  const ros::Time stamp = msg.markers.empty() ? ros::TIME_MIN : msg.markers[0].header.stamp;
+  write(nh_.resolveName("markers"), msg, stamp);
+  if (markers_.add(std::lround(stamp.toSec() / timeStep_))) report();
 }
 
 void RecorderNode::onMonitorProgress(const ros::MessageEvent<RunProgress const>& event) {
@@ -213,10 +215,9 @@ void RecorderNode::onMonitorProgress(const ros::MessageEvent<RunProgress const>&
 
 void RecorderNode::report() {
   if (progress_.state == RunProgress::FAILED || progress_.state == RunProgress::FINISHED) return;
-  // Complete up to k: every agent's states and the status up to k, and the markers have come.
-  long complete = status_.next - 1;
+  // Complete up to k: every agent's states, the status and the markers up to k.
+  long complete = std::min(status_.next, markers_.next) - 1;
   for (const Steps& s : states_) complete = std::min(complete, s.next - 1);
-  if (markers_ == 0) complete = -1;
   if (complete <= progress_.completed_step) return;
   progress_.completed_step = complete;
   progress_.header.stamp.fromSec(static_cast<double>(complete) * timeStep_);

@@ -120,10 +120,11 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
         for args, marker, words in cases:
             run = run_formation(*args, timeout=60)
             out = run.stdout + run.stderr
-            lines = [line for line in out.splitlines() if marker in line]
+            # One line; a respawning node may print it again before the launch ends.
+            lines = {re.sub(r"\[\d+\.\d+\]", "", line) for line in out.splitlines() if marker in line}
             self.assertNotEqual(run.returncode, 0, f"{args}: {out[-3000:]}")
             self.assertEqual(len(lines), 1, f"{args}: {out[-3000:]}")
-            self.assertIn(words, lines[0], args)
+            self.assertIn(words, lines.pop(), args)
 
     def check_killed_agent_fails_the_run(self, kill, victim):
         out = os.path.join(self.tmp, "killed")
@@ -277,9 +278,10 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
             log, _ = run.communicate(timeout=40)
         self.assertEqual(run.returncode, 0, log[-3000:])
         self.assertEqual(list(sizes), ["unbounded_recorded.bag"] + [f"unbounded_recorded_{k}.bag" for k in (1, 2, 3)])
+        # A file ends with the message that crossed its size, then rosbag adds its index (a few %).
         for f, size in sizes.items():
-            self.assertLess(size, 0.5e6 + 100e3, f)  # a file ends with the message that crossed 0.5 MB
-        self.assertLess(sum(sizes.values()), 2e6 + 100e3)
+            self.assertLess(size, 0.5e6 * 1.15, f)
+        self.assertLess(sum(sizes.values()), 2e6 * 1.1)
         self.assertGreaterEqual(sum(sizes.values()), 2e6)
         self.assertEqual(log.count("the size limit of 2 MB ends the recording"), 1, log[-3000:])
         # The parts hold the first steps of every agent, without a gap between files.

@@ -76,8 +76,8 @@ class RecorderNode {
   double timeStep_ = 0.0;
   std::vector<std::string> owners_;
   std::vector<Steps> states_;
-  Steps status_;
-  long markers_ = 0, written_ = 0, repeats_ = 0, dropped_ = 0;
+  Steps status_, markers_;  // markers by the step of their stamp t_k
+  long written_ = 0, repeats_ = 0, dropped_ = 0;
   bool open_ = false;
   ros::WallTimer catchUpTimer_;
   ros::WallTime stalledSince_;
