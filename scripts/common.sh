@@ -19,7 +19,7 @@ VF_APT_PACKAGES=(
   ros-tf2-msgs librosbag-dev python3-rosbag python3-rostest librostest-dev python3-roslaunch
   rosbash rviz libeigen3-dev libyaml-cpp-dev libgtest-dev googletest libbenchmark-dev
   python3-matplotlib python3-numpy python3-yaml xvfb x11-apps python3-tf2-ros
-  python3-rosparam python3-rospkg
+  python3-rosparam python3-rospkg python3-rosunit iproute2
 )
 
 vf_install_dependencies() {

@@ -47,7 +47,7 @@ HOST_NUMBER = {"A": 1, "B": 2, "C": 3}
 AGENTS_ON = {"B": (0, 2, 4), "C": (1, 3, 5)}
 # Master ports (per namespace, but kept apart anyway): one per test case and benchmark run.
 PORT_RUN, PORT_KILL, PORT_BENCH_HOSTS, PORT_BENCH_ONE = 11750, 11751, 11752, 11753
-RUN_TIMEOUT = 60.0
+RUN_TIMEOUT = 50.0  # seconds; a run takes a few (4.2 s at rate 1)
 
 
 def address(host):
@@ -58,8 +58,11 @@ def host_of(agent):
     return next(h for h, ids in AGENTS_ON.items() if agent in ids)
 
 
+IP = shutil.which("ip") or next((p for p in ("/usr/sbin/ip", "/sbin/ip") if os.path.exists(p)), "ip")
+
+
 def ip(*args, check=True):
-    return subprocess.run(["ip", *args], capture_output=True, text=True, check=check)
+    return subprocess.run([IP, *args], capture_output=True, text=True, check=check)
 
 
 def kill_group(proc, timeout=15.0):
@@ -100,6 +103,12 @@ def executable_of(pid):
     return ""
 
 
+def report(line):
+    """To the test's output: the JUnit file (rosunit captures stdout) and the console."""
+    for stream in {sys.stdout, sys.__stdout__}:
+        print(line, file=stream, flush=True)
+
+
 def monitor_rate(log):
     """(steps, seconds, steps/s) of the monitor's final line, or None."""
     m = re.search(r"monitor: (\d+) steps in ([0-9.]+) s: (\d+) steps/s", log)
@@ -129,9 +138,12 @@ class Hosts:
 
     def up(self):
         # One run per port at a time: a second one waits here instead of removing the first's hosts.
-        self.lock = open(os.path.join(tempfile.gettempdir(), f"vf_multihost_{self.port}.lock"), "w")
+        self.lock = os.open(os.path.join(tempfile.gettempdir(), f"vf_multihost_{self.port}.lock"),
+                            os.O_RDONLY | os.O_CREAT, 0o644)
         fcntl.flock(self.lock, fcntl.LOCK_EX)
         self.remove_namespaces()  # leftovers of an interrupted run
+        if not os.path.exists(IP) and not shutil.which(IP):
+            raise AssertionError("multihost: the `ip` command (Debian package iproute2) is missing")
         made = ip("netns", "add", self.bridge, check=False)
         if made.returncode != 0:
             raise AssertionError(
@@ -164,27 +176,28 @@ class Hosts:
         for proc in reversed(self.procs):
             kill_group(proc)
         self.remove_namespaces()
-        if self.lock:
-            self.lock.close()
+        if self.lock is not None:
+            os.close(self.lock)
             self.lock = None
 
     def start(self, host, name, cmd):
         """A process on `host`, its output in workdir/<name>.log."""
         path = os.path.join(self.workdir, name + ".log")
         with open(path, "w") as log:
-            proc = subprocess.Popen(["ip", "netns", "exec", self.ns[host], *cmd], env=self.env(host), stdout=log,
+            proc = subprocess.Popen([IP, "netns", "exec", self.ns[host], *cmd], env=self.env(host), stdout=log,
                                     stderr=subprocess.STDOUT, start_new_session=True)
         self.procs.append(proc)
         self.logs[name] = path
         return proc
 
     def run(self, host, cmd, timeout):
-        return subprocess.run(["ip", "netns", "exec", self.ns[host], *cmd], env=self.env(host), capture_output=True,
+        return subprocess.run([IP, "netns", "exec", self.ns[host], *cmd], env=self.env(host), capture_output=True,
                               text=True, timeout=timeout)
 
     def log(self, name, tail=3000):
         with open(self.logs[name], errors="replace") as f:
-            return f.read()[-tail:] if tail else f.read()
+            text = re.sub(r"\x1b\[[0-9;]*m|\x1b\]2;[^\x07]*\x07", "", f.read())
+        return text[-tail:] if tail else text
 
     def probe(self, *args, timeout=30.0):
         """This script's --probe mode on host A (the test itself runs outside the hosts)."""
@@ -314,9 +327,9 @@ class MultiHost(unittest.TestCase, vf_rostest.RunChecks):
         self.assertEqual(problems, [])
         for name, info in graph.items():
             peers = sorted({re.sub(r".* to \[([0-9.]+):.*", r"\1", c[6]) for c in info["bus"] if c[2] == "i"})
-            print(f"multihost: {name} at {info['uri']}, receives states from {', '.join(peers)}", flush=True)
+            report(f"multihost: {name} at {info['uri']}, receives states from {', '.join(peers)}")
 
-    def run_formation(self, hosts, kill=None):
+    def run_formation(self, hosts, kill=None, victim=None):
         """The run: master and agents first (they wait for the monitor), then formation.launch on
         A. `kill(hosts, agents)` runs once the monitor is up. Returns the result file."""
         hosts.start_master()
@@ -331,18 +344,28 @@ class MultiHost(unittest.TestCase, vf_rostest.RunChecks):
                                              "agents:=false", "record:=true", f"output_dir:={out}", *extra])
         if kill:
             kill(hosts, agents)
+        timeout = RUN_TIMEOUT if kill else RUN_TIMEOUT / 2
         try:
-            run.wait(timeout=RUN_TIMEOUT)
+            run.wait(timeout=timeout)
+            late = ""
         except subprocess.TimeoutExpired:
-            self.fail(f"the run did not end within {RUN_TIMEOUT:.0f} s:\n{hosts.log('formation')}")
+            kill_group(run)  # the monitor writes why it was still waiting
+            late = f"the run did not end within {timeout:.0f} s; "
         result_path = os.path.join(out, SCENARIO + ".result.yaml")
         result = {}
         if os.path.exists(result_path):
             with open(result_path) as f:
                 result = yaml.safe_load(f) or {}
-        self.assertEqual(result.get("result"), "succeeded", f"{result}\n{hosts.log('formation')}")
+        victim_log = f"\nagent_{victim}'s roslaunch:\n{hosts.log(f'agent_{victim}', 1500)}" if kill else ""
+        self.assertEqual(result.get("result"), "succeeded",
+                         f"{late}result file: {result}\n{hosts.log('formation')}{victim_log}")
         self.assertEqual(run.returncode, 0, hosts.log("formation"))
         for i, proc in agents.items():
+            if kill:
+                # roslaunch restarts a respawn="true" node whatever its exit status, so these
+                # launches do not end by themselves after the run: end them.
+                kill_group(proc)
+                continue
             try:
                 proc.wait(timeout=30)
             except subprocess.TimeoutExpired:
@@ -375,13 +398,13 @@ class MultiHost(unittest.TestCase, vf_rostest.RunChecks):
             self.assertEqual(len(pids), 1, f"agent_{victim}'s process under its roslaunch: {pids}")
             os.kill(pids[0], signal.SIGKILL)
             killed.update(pid=pids[0], step=seen)
-            print(f"multihost: seed {seed}: SIGKILL to agent_{victim} (pid {pids[0]}) on host B "
-                  f"({address('B')}) at step {seen} (drawn: {step})", flush=True)
+            report(f"multihost: seed {seed}: SIGKILL to agent_{victim} (pid {pids[0]}) on host B "
+                   f"({address('B')}) at step {seen} (drawn: {step}); VF_MULTIHOST_SEED={seed} repeats it")
 
         hosts = Hosts(PORT_KILL, self.tmp)
         try:
             hosts.up()
-            self.run_formation(hosts, kill)
+            self.run_formation(hosts, kill, victim)
         finally:
             hosts.down()
         self.assertIn("pid", killed, "the agent was not killed")
