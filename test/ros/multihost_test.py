@@ -442,16 +442,16 @@ def benchmark(steps, repeats):
                       flush=True)
         print(f"\nhexagon, {steps} steps, h = {s['time_step']}, no recording, {repeats} runs each "
               f"(median; the monitor's steps/s from step 0 to the last)")
-        print(f"{'setup':36} {'steps/s':>10} {'real-time factor':>17}")
+        print(f"{'setup':48} {'steps/s':>10} {'real-time factor':>17}")
         medians = {}
         for setup, label in (("3 hosts", "agents on 2 namespace hosts, monitor on a 3rd"),
                              ("1 host", "all on one host (loopback)")):
             rates = sorted(m[2] for st, m in rows if st == setup and m)
             if not rates:
-                print(f"{label:36} {'failed':>10}")
+                print(f"{label:48} {'failed':>10}")
                 continue
             medians[setup] = rates[len(rates) // 2]
-            print(f"{label:36} {medians[setup]:10.0f} {medians[setup] * s['time_step']:17.1f}")
+            print(f"{label:48} {medians[setup]:10.0f} {medians[setup] * s['time_step']:17.1f}")
         if len(medians) == 2:
             print(f"3 hosts / 1 host: {medians['3 hosts'] / medians['1 host']:.2f}")
         return 0 if len(medians) == 2 else 1
