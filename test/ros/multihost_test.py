@@ -11,7 +11,8 @@ interface or route of the root namespace is touched.
 Checks: the run succeeds, the bag is complete and equals simulate bit for bit, and every agent's
 node lives on its host's address with real TCP connections to its neighbours on the other host.
 A second case SIGKILLs one agent on host B at a seeded random step, with respawn:=true, and
-expects the same (it needs crash recovery in the agent and the monitor).
+expects the same (it needs crash recovery in the agent and the monitor). A third loads
+launch/examples/several_hosts.launch (machine tags) and checks that it puts one agent on each robot.
 
 Without permission for `ip netns` (not root) the test fails, saying so.
 
@@ -410,6 +411,18 @@ class MultiHost(unittest.TestCase, vf_rostest.RunChecks):
         self.assertIn("pid", killed, "the agent was not killed")
         self.assertGreaterEqual(killed["step"], step)
         self.assertLess(killed["step"], int(self.scenario["steps"]), "killed after the run")
+
+    def test_example_with_machine_tags_puts_one_agent_on_each_robot(self):
+        import roslaunch.config
+        path = os.path.join(rospkg.RosPack().get_path(PKG), "launch", "examples", "several_hosts.launch")
+        config = roslaunch.config.load_config_default([path], None)
+        placed = {n.namespace + n.name: n.machine_name for n in config.nodes}
+        n = self.scenario["n"]
+        self.assertEqual(sorted(placed), sorted([f"/formation/agent_{i}" for i in range(n)] +
+                                                ["/formation/monitor", "/formation/recorder"]))
+        addresses = {config.machines[placed[f"/formation/agent_{i}"]].address for i in range(n)}
+        self.assertEqual(len(addresses), n, "one robot (machine address) per agent")
+        self.assertFalse(placed["/formation/monitor"], "the monitor runs beside the master, on no robot")
 
 
 def formation_args():
