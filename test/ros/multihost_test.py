@@ -48,7 +48,7 @@ HOST_NUMBER = {"A": 1, "B": 2, "C": 3}
 AGENTS_ON = {"B": (0, 2, 4), "C": (1, 3, 5)}
 # Master ports (per namespace, but kept apart anyway): one per test case and benchmark run.
 PORT_RUN, PORT_KILL, PORT_BENCH_HOSTS, PORT_BENCH_ONE = 11750, 11751, 11752, 11753
-RUN_TIMEOUT = 40.0  # seconds from formation.launch's start; a run takes a few (4.2 s at rate 1)
+RUN_TIMEOUT = 30.0  # seconds from formation.launch's start; a run takes a few (4.2 s at rate 1)
 
 
 def address(host):
@@ -66,18 +66,21 @@ def ip(*args, check=True):
     return subprocess.run([IP, *args], capture_output=True, text=True, check=check)
 
 
-def kill_group(proc, timeout=15.0):
-    """SIGINT to a process group we started (roslaunch shuts its nodes down), SIGKILL if it hangs."""
-    if proc.poll() is not None:
-        return
-    with contextlib.suppress(ProcessLookupError):
-        os.killpg(proc.pid, signal.SIGINT)
-    try:
-        proc.wait(timeout=timeout)
-    except subprocess.TimeoutExpired:
+def kill_group(*procs, timeout=15.0):
+    """SIGINT to process groups we started (roslaunch shuts its nodes down), all at once, then
+    SIGKILL to those still there after `timeout` seconds."""
+    running = [p for p in procs if p.poll() is None]
+    for proc in running:
         with contextlib.suppress(ProcessLookupError):
-            os.killpg(proc.pid, signal.SIGKILL)
-        proc.wait(timeout=5)
+            os.killpg(proc.pid, signal.SIGINT)
+    end = time.time() + timeout
+    for proc in running:
+        try:
+            proc.wait(timeout=max(0.1, end - time.time()))
+        except subprocess.TimeoutExpired:
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait(timeout=5)
 
 
 def descendants(pid):
@@ -127,7 +130,7 @@ class Hosts:
         self.ns = {h: f"{self.prefix}_{h.lower()}" for h in HOST_NUMBER}
         self.bridge = f"{self.prefix}_br"
         self.procs, self.logs = [], {}
-        self.lock = None
+        self.master = self.lock = None
 
     def all_namespaces(self):
         return [self.bridge, *self.ns.values()]
@@ -174,8 +177,9 @@ class Hosts:
             ip("netns", "del", ns, check=False)
 
     def down(self):
-        for proc in reversed(self.procs):
-            kill_group(proc)
+        # The nodes first, so that they can still unregister, then the master.
+        kill_group(*[p for p in self.procs if p is not self.master])
+        kill_group(*self.procs)
         self.remove_namespaces()
         if self.lock is not None:
             os.close(self.lock)
@@ -208,7 +212,7 @@ class Hosts:
         return json.loads(run.stdout.strip().splitlines()[-1])
 
     def start_master(self):
-        self.start("A", "roscore", ["roscore", "-p", str(self.port)])
+        self.master = self.start("A", "roscore", ["roscore", "-p", str(self.port)])
         self.probe("master", timeout=40.0)
 
     def start_agents(self, scenario, *extra):
@@ -254,22 +258,24 @@ def probe_graph(names, timeout=40.0):
     return out
 
 
-def probe_step(step, timeout):
-    """Waits until the monitor's status reaches `step`; the newest step seen."""
+def probe_step(topic, step, timeout):
+    """Waits until an agent's state on `topic` reaches `step`; the newest step seen."""
     import threading
 
     import rospy
-    from variational_formation.msg import FormationStatus
+    from variational_formation.msg import AgentState
     reached, seen = threading.Event(), [-1]
 
-    def on_status(msg):
+    def on_state(msg):
         seen[0] = max(seen[0], msg.step)
         if seen[0] >= step:
             reached.set()
 
     rospy.init_node("multihost_watch", anonymous=True, disable_signals=True)
-    sub = rospy.Subscriber("/formation/status", FormationStatus, on_status, queue_size=10000)
+    sub = rospy.Subscriber(topic, AgentState, on_state, queue_size=10000, tcp_nodelay=True)
+    print("watching", flush=True)
     reached.wait(timeout)
+    print(json.dumps({"step": seen[0]}), flush=True)  # at once: rospy takes a while to shut down
     sub.unregister()
     return {"step": seen[0]}
 
@@ -280,7 +286,7 @@ def probe_main(args):
     elif args[0] == "graph":
         result = probe_graph(args[1:])
     else:
-        result = probe_step(int(args[1]), float(args[2]))
+        result = probe_step(args[1], int(args[2]), float(args[3]))
     print(json.dumps(result))
 
 
@@ -332,7 +338,8 @@ class MultiHost(unittest.TestCase, vf_rostest.RunChecks):
 
     def run_formation(self, hosts, kill=None, victim=None):
         """The run: master and agents first (they wait for the monitor), then formation.launch on
-        A. `kill(hosts, agents)` runs once formation.launch is started. Returns the recording."""
+        A. With kill = (step, action), action(agents, seen) runs once the victim has published
+        `step` (seen: the newest step a watcher on A has from it). Returns the recording."""
         hosts.start_master()
         respawn = ["respawn:=true", "rate:=1"] if kill else []
         agents = hosts.start_agents(SCENARIO, *respawn)
@@ -340,11 +347,27 @@ class MultiHost(unittest.TestCase, vf_rostest.RunChecks):
         extra = []
         if kill and "respawn_timeout" in formation_args():
             extra.append("respawn_timeout:=20")
+        if kill:
+            # The watcher subscribes before the run starts, so it sees the step when it comes.
+            watcher = hosts.start("A", "watch", ["/usr/bin/python3", os.path.abspath(__file__), "--probe", "step",
+                                                 f"/formation/agent_{victim}/state", str(kill[0]), str(RUN_TIMEOUT)])
+            end = time.time() + 30
+            while "watching" not in hosts.log("watch") and watcher.poll() is None and time.time() < end:
+                time.sleep(0.1)
+            self.assertIn("watching", hosts.log("watch"), "the step watcher did not start")
         out = os.path.join(self.tmp, "out")
         run = hosts.start("A", "formation", ["rosrun", PKG, "run_formation.sh", f"scenario:={SCENARIO}",
                                              "agents:=false", "record:=true", f"output_dir:={out}", *extra])
         if kill:
-            kill(hosts, agents)
+            end = time.time() + RUN_TIMEOUT + 10
+            while not re.search(r"^\{.*\}$", hosts.log("watch"), re.M) and time.time() < end:
+                time.sleep(0.01)
+            found = re.search(r"^\{.*\}$", hosts.log("watch"), re.M)
+            self.assertTrue(found, f"the step watcher said nothing:\n{hosts.log('watch')}\n{hosts.log('formation')}")
+            seen = json.loads(found.group(0))["step"]
+            self.assertGreaterEqual(seen, kill[0], f"the run did not reach step {kill[0]}:\n{hosts.log('formation')}")
+            self.assertLess(seen, int(self.scenario["steps"]), "the watcher saw the step only after the run")
+            kill[1](agents, seen)
         timeout = RUN_TIMEOUT
         try:
             run.wait(timeout=timeout)
@@ -361,17 +384,17 @@ class MultiHost(unittest.TestCase, vf_rostest.RunChecks):
         self.assertEqual(result.get("result"), "succeeded",
                          f"{late}result file: {result}\n{hosts.log('formation')}{victim_log}")
         self.assertEqual(run.returncode, 0, hosts.log("formation"))
+        if kill:
+            # roslaunch restarts a respawn="true" node whatever its exit status, so these
+            # launches do not end by themselves after the run: end them.
+            kill_group(*agents.values())
         for i, proc in agents.items():
-            if kill:
-                # roslaunch restarts a respawn="true" node whatever its exit status, so these
-                # launches do not end by themselves after the run: end them.
-                kill_group(proc)
-                continue
             try:
                 proc.wait(timeout=30)
             except subprocess.TimeoutExpired:
                 self.fail(f"agent_{i}'s roslaunch on host {host_of(i)} did not end:\n{hosts.log(f'agent_{i}')}")
-            self.assertEqual(proc.returncode, 0, hosts.log(f"agent_{i}"))
+            if not kill:
+                self.assertEqual(proc.returncode, 0, hosts.log(f"agent_{i}"))
         rec = vf_rostest.Recording(os.path.join(out, SCENARIO + ".bag"))
         self.check_recording(rec, self.scenario, self.expected)
         return rec
@@ -393,25 +416,22 @@ class MultiHost(unittest.TestCase, vf_rostest.RunChecks):
         step = rng.randint(10, int(self.scenario["steps"]) - 20)
         killed = {}
 
-        def kill(hosts, agents):
-            seen = hosts.probe("step", str(step), "40", timeout=60.0)["step"]
-            self.assertGreaterEqual(seen, step, f"the run did not reach step {step}:\n{hosts.log('formation')}")
+        def kill(agents, seen):
             pids = [p for p in descendants(agents[victim].pid) if executable_of(p).endswith("/agent")]
             self.assertEqual(len(pids), 1, f"agent_{victim}'s process under its roslaunch: {pids}")
             os.kill(pids[0], signal.SIGKILL)
             killed.update(pid=pids[0], step=seen)
             report(f"multihost: seed {seed}: SIGKILL to agent_{victim} (pid {pids[0]}) on host B "
-                   f"({address('B')}) once the monitor completed step {seen} (drawn: {step}); "
+                   f"({address('B')}) once it had published step {seen} (drawn: {step}); "
                    f"VF_MULTIHOST_SEED={seed} draws the same")
 
         hosts = Hosts(PORT_KILL, self.tmp)
         try:
             hosts.up()
-            self.run_formation(hosts, kill, victim)
+            self.run_formation(hosts, (step, kill), victim)
         finally:
             hosts.down()
         self.assertIn("pid", killed, "the agent was not killed")
-        self.assertLess(killed["step"], int(self.scenario["steps"]), "killed after the run")
 
     def test_example_with_machine_tags_puts_one_agent_on_each_robot(self):
         import roslaunch.config
