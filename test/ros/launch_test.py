@@ -176,7 +176,6 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
                 os.killpg(a.pid, signal.SIGINT)
                 log, _ = a.communicate(timeout=30)
                 logs.append(log)
-                self.assertIn("the run is over at step 300 (finished)", log)
         finally:
             for p in stray + agents:
                 if p.poll() is None:

@@ -384,17 +384,14 @@ class MultiHost(unittest.TestCase, vf_rostest.RunChecks):
         self.assertEqual(result.get("result"), "succeeded",
                          f"{late}result file: {result}\n{hosts.log('formation')}{victim_log}")
         self.assertEqual(run.returncode, 0, hosts.log("formation"))
-        if kill:
-            # roslaunch restarts a respawn="true" node whatever its exit status, so these
-            # launches do not end by themselves after the run: end them.
-            kill_group(*agents.values())
+        # After a run the agents stay up, idle (a respawning node that exited would only be
+        # restarted), as on robots: end their launches.
+        kill_group(*agents.values())
         for i, proc in agents.items():
             try:
                 proc.wait(timeout=30)
             except subprocess.TimeoutExpired:
                 self.fail(f"agent_{i}'s roslaunch on host {host_of(i)} did not end:\n{hosts.log(f'agent_{i}')}")
-            if not kill:
-                self.assertEqual(proc.returncode, 0, hosts.log(f"agent_{i}"))
         rec = vf_rostest.Recording(os.path.join(out, SCENARIO + ".bag"))
         self.check_recording(rec, self.scenario, self.expected)
         return rec
@@ -440,7 +437,7 @@ class MultiHost(unittest.TestCase, vf_rostest.RunChecks):
         placed = {n.namespace + n.name: n.machine_name for n in config.nodes}
         n = self.scenario["n"]
         self.assertEqual(sorted(placed), sorted([f"/formation/agent_{i}" for i in range(n)] +
-                                                ["/formation/monitor", "/formation/recorder"]))
+                                                ["/formation/end_of_run", "/formation/monitor", "/formation/recorder"]))
         addresses = {config.machines[placed[f"/formation/agent_{i}"]].address for i in range(n)}
         self.assertEqual(len(addresses), n, "one robot (machine address) per agent")
         self.assertFalse(placed["/formation/monitor"], "the monitor runs beside the master, on no robot")
