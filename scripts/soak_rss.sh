@@ -20,7 +20,7 @@ roslaunch -p "$port" variational_formation formation.launch scenario:="$tmp/soak
 launch=$!
 trap 'kill -INT $launch 2>/dev/null; wait $launch 2>/dev/null; rm -rf "$tmp"' EXIT
 sleep 5
-pids() { pgrep -f "__name:=(agent_[0-9]+|monitor)" ; }
+pids() { pgrep -P "$launch" -f "__name:=(agent_[0-9]+|monitor)" ; }  # this launch's nodes only
 names=()
 for pid in $(pids); do names+=("$(tr '\0' ' ' </proc/"$pid"/cmdline | grep -oE '__name:=[a-z_0-9]+' | cut -d= -f2)"); done
 printf '%8s %10s' minute step; printf ' %9s' "${names[@]}"; echo

@@ -26,7 +26,7 @@ LockstepAgent::LockstepAgent(const Scenario& scenario, int id, StartMethod start
              scenario.initialVelocities.col(id).data() + dimension_);
   for (const Neighbour& nb : formation_.neighbours(id)) neighbourIds_.push_back(nb.agent);
   neighbours_.resize(static_cast<std::size_t>(n));
-  view_ = Positions::Zero(dimension_, n);
+  neighbourhoodPositions_ = Positions::Zero(dimension_, n);
 }
 
 std::string LockstepAgent::describe(Receipt receipt) {
@@ -96,13 +96,13 @@ bool LockstepAgent::ready() const {
 
 void LockstepAgent::advance() {
   if (!ready()) throw InvalidInput("advance: a neighbour's state at step " + std::to_string(step_) + " is missing");
-  for (int a = 0; a < dimension_; ++a) view_(a, id_) = q_[a];
+  for (int a = 0; a < dimension_; ++a) neighbourhoodPositions_(a, id_) = q_[a];
   for (int j : neighbourIds_) {
     const double* qj = neighbourPositionAtStep(neighbours_[static_cast<std::size_t>(j)]);
-    for (int a = 0; a < dimension_; ++a) view_(a, j) = qj[a];
+    for (int a = 0; a < dimension_; ++a) neighbourhoodPositions_(a, j) = qj[a];
   }
   double gradient[3];
-  formation_.agentGradient(id_, view_, gradient);
+  formation_.agentGradient(id_, neighbourhoodPositions_, gradient);
   std::vector<double> next(static_cast<std::size_t>(dimension_));
   if (step_ > 0) {
     // doc/maths.md §2, explicit update, as in VariationalIntegrator::step.

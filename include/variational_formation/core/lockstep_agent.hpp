@@ -82,7 +82,7 @@ class LockstepAgent {
   std::vector<double> qPrev_, q_, v0_, qBeforePrev_;
   std::vector<int> neighbourIds_;
   std::vector<NeighbourState> neighbours_;  // indexed by agent id (only neighbours used)
-  Positions view_;                          // q_k of self and neighbours, d x n
+  Positions neighbourhoodPositions_;  // q_k of self and neighbours (other columns unused), d x n
 };
 
 }  // namespace vf
