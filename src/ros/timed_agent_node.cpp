@@ -104,8 +104,11 @@ void TimedAgentNode::onProgress(const ros::MessageEvent<RunProgress const>& even
   const RunProgress& p = *event.getConstMessage();
   if (p.state == RunProgress::FINISHED || p.state == RunProgress::FAILED) {
     if (exitStatus_ < 0) {
-      ROS_INFO("%s: the run is over at step %ld (%s); idle until shut down", name_.c_str(), agent_->step(),
-               p.state == RunProgress::FINISHED ? "finished" : ("failed: " + p.reason).c_str());
+      ROS_INFO("%s: the run is over at step %ld (%s); %ld ticks held, %ld neighbour states lost (injected), %ld "
+               "outdated or refused; idle until shut down",
+               name_.c_str(), agent_->step(),
+               p.state == RunProgress::FINISHED ? "finished" : ("failed: " + p.reason).c_str(), agent_->heldTicks(),
+               faults_->lost(), agent_->dropped());
     }
     exitStatus_ = p.state == RunProgress::FINISHED ? 0 : 1;
     running_ = false;
@@ -147,6 +150,11 @@ void TimedAgentNode::onTick() {
   if (robot_ && !haveOdometry_) {
     ROS_WARN_THROTTLE(kReportEvery, "%s: holding: no odometry on %s yet", name_.c_str(), odomSub_.getTopic().c_str());
     return;
+  }
+  if (!running_ && exitStatus_ < 0 && secondsSince(lastPublishAt_) > 0.25 * agent_->maxAge()) {
+    // Before the start, keep the neighbours' copy of our first state fresh: else they would
+    // find it older than max_age at their first tick and hold once.
+    publish();
   }
   if (!running_ || agent_->finished()) return;
   if (robot_) agent_->setMeasuredPosition(measured_);
@@ -193,6 +201,7 @@ void TimedAgentNode::publish() {
   msg.previous_position = agent_->previousPosition();
   msg.dropped = static_cast<uint32_t>(dropped_ + agent_->dropped());
   statePub_.publish(msg);
+  lastPublishAt_ = ros::WallTime::now();
 
   geometry_msgs::PoseStamped pose;
   pose.header = msg.header;

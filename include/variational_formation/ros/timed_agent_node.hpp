@@ -81,7 +81,7 @@ class TimedAgentNode {
   bool running_ = false;
   long dropped_ = 0;
   int exitStatus_ = -1;  // -1: running
-  ros::WallTime lastReportAt_;
+  ros::WallTime lastReportAt_, lastPublishAt_;
   std::string name_, frame_;
 };
 
