@@ -188,6 +188,7 @@ void TimedAgentNode::onTick() {
     }
   }
   publish();
+  if (robot_ && agent_->finished()) cmdVelPub_.publish(geometry_msgs::Twist());  // our last step: stop the robot
 }
 
 void TimedAgentNode::publish() {
