@@ -20,7 +20,7 @@ constexpr double kReportEvery = 5.0;  // seconds between "waiting for ..." lines
 constexpr double kHoldReportEvery = 2.0;
 }  // namespace
 
-TimedAgentNode::TimedAgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
+TimedAgentNode::TimedAgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), diagnostics_(nh, pnh) {
   const int id = requiredParam<int>(pnh, "id");
   const std::string path = requiredParam<std::string>(pnh, "scenario");
   rate_ = optionalParam(pnh, "real_time_factor", 0.0);
@@ -70,6 +70,13 @@ TimedAgentNode::TimedAgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
     cmdVelPub_ = pnh.advertise<geometry_msgs::Twist>("cmd_vel", 10);
   }
   recallServer_ = nh.advertiseService(name_ + "/recall", &TimedAgentNode::onRecall, this);
+  // The server starts from ~kappa: the scenario's (an earlier value would be another run's).
+  pnh.setParam("kappa", scenario.dampingGain);
+  reconfigure_ = std::make_unique<dynamic_reconfigure::Server<variational_formation::TimedAgentConfig>>(pnh);
+  reconfigure_->setCallback(
+      [this](variational_formation::TimedAgentConfig& config, uint32_t level) { onReconfigure(config, level); });
+  diagnostics_.setHardwareID(frame_);
+  diagnostics_.add("timed agent", this, &TimedAgentNode::diagnose);
   for (const std::string& w : scenario.warnings) ROS_WARN("%s: %s", name_.c_str(), w.c_str());
   ROS_INFO("%s: timed mode, scenario '%s' (%s), %d neighbours, kappa %g, h %g, tick %g s, delay %g s, jitter %g s, "
            "loss %g, seed %d, max_age %g s%s, monitor %s",
@@ -131,7 +138,52 @@ void TimedAgentNode::onOdometry(const nav_msgs::Odometry& odom) {
   haveOdometry_ = true;
 }
 
+void TimedAgentNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  const double t = now();
+  const double rate = diagnosedAt_ > 0.0 && t > diagnosedAt_ ? (agent_->step() - diagnosedStep_) / (t - diagnosedAt_) : 0.0;
+  diagnosedStep_ = agent_->step();
+  diagnosedAt_ = t;
+  if (exitStatus_ >= 0 || agent_->finished()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "run over");
+  } else if (!running_) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "waiting for the monitor to start the run");
+  } else if (robot_ && !haveOdometry_) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "holding: no odometry yet");
+  } else if (agent_->holding()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "holding: a neighbour is silent");
+  } else {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "stepping");
+  }
+  status.add("step", agent_->step());
+  status.add("step rate [1/s]", rate);
+  status.add("expected step rate [1/s]", rate_ / h_);
+  status.add("holding", agent_->holding());
+  status.add("held ticks", agent_->heldTicks());
+  status.add("states lost (injected)", faults_->lost());
+  status.add("states refused (outdated or malformed)", agent_->dropped());
+  status.add("states dropped (not from the owner)", dropped_);
+  status.add("kappa [1/s]", agent_->dampingGain());
+  for (const TimedAgent::NeighbourStatus& n : agent_->neighbourStatus(t)) {
+    const std::string who = "agent_" + std::to_string(n.id);
+    status.add(who + " age [s]", n.heard ? n.age : -1.0);
+    status.add(who + " accepted", n.accepted);
+    status.add(who + " dropped", n.dropped);
+  }
+}
+
+void TimedAgentNode::onReconfigure(variational_formation::TimedAgentConfig& config, uint32_t) {
+  if (config.kappa == agent_->dampingGain()) return;
+  try {
+    agent_->setDampingGain(config.kappa);
+    ROS_INFO("%s: kappa set to %g at step %ld", name_.c_str(), config.kappa, agent_->step());
+  } catch (const std::exception& e) {
+    ROS_WARN("%s: kappa not changed: %s", name_.c_str(), e.what());
+    config.kappa = agent_->dampingGain();
+  }
+}
+
 void TimedAgentNode::onTick() {
+  diagnostics_.update();  // rate-limited by the updater itself (~diagnostic_period, 1 s)
   const double t = now();
   for (Received& r : faults_->takeDue(t)) {
     const AgentState& s = r.state;

@@ -8,8 +8,9 @@ Private parameters:
   max_age     the agents' (a respawn takes about 0.4 s: the kill case uses 0.1 s to see holds)
   kill        >= 0: SIGKILL that agent's process 1 s into the run; its neighbours must hold
               (q_{k+1} = q_k exactly) while it is dead, it respawns, and the formation converges
+  reconfigure_kappa  > 0: 2 s into the run, set every agent's kappa to it (dynamic_reconfigure)
   output_dir  where the monitor writes its result file (removed after)
-It prints the convergence time: the first tick of the final congruent stretch times h / rate.
+Every case also checks each agent's /diagnostics (step rate near 1/h). It prints the convergence time: the first tick of the final congruent stretch times h / rate.
 """
 import os
 import shutil
@@ -23,6 +24,8 @@ import xmlrpc.client
 import rosgraph
 import rospy
 import rostest
+from diagnostic_msgs.msg import DiagnosticArray
+from dynamic_reconfigure.client import Client
 from variational_formation.msg import AgentState, FormationStatus
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -54,6 +57,14 @@ class TimedRun(unittest.TestCase):
         cls.expect = rospy.get_param("~expect", "converged")
         cls.victim = int(rospy.get_param("~kill", -1))
         cls.max_age = float(rospy.get_param("~max_age", 0.5))
+        cls.kappa = float(rospy.get_param("~reconfigure_kappa", 0.0))
+        cls.diagnostics = {}
+
+        def on_diagnostics(msg):
+            with lock:
+                for st in msg.status:
+                    if st.name.endswith(": timed agent"):
+                        cls.diagnostics.setdefault(st.name.split(":")[0].split("/")[-1], []).append(st)
         cls.out = rospy.get_param("~output_dir")
         cls.scenario = vf_rostest.load_scenario(cls.path)
         cls.h = float(cls.scenario["time_step"])
@@ -68,7 +79,8 @@ class TimedRun(unittest.TestCase):
             with lock:
                 cls.states.setdefault(msg.id, []).append((time.monotonic(), msg))
 
-        cls.subs = [rospy.Subscriber(NS + "/status", FormationStatus, on_status, queue_size=100000)]
+        cls.subs = [rospy.Subscriber(NS + "/status", FormationStatus, on_status, queue_size=100000),
+                    rospy.Subscriber("/diagnostics", DiagnosticArray, on_diagnostics, queue_size=1000)]
         cls.neighbours = cls.scenario["neighbours"].get(cls.victim, [])
         for j in cls.neighbours + ([cls.victim] if cls.victim >= 0 else []):
             cls.subs.append(rospy.Subscriber(f"{NS}/agent_{j}/state", AgentState, on_state, queue_size=100000))
@@ -83,6 +95,12 @@ class TimedRun(unittest.TestCase):
             node_pid(name, old=pid)
             cls.respawned_at = time.monotonic()
             print(f"agent_{cls.victim} killed, back {cls.respawned_at - cls.killed_at:.2f} s later", flush=True)
+        if cls.kappa > 0:
+            while not cls.status or cls.status[-1][1].step < 140:  # 2 s into the run
+                time.sleep(0.01)
+            for i in range(cls.scenario["n"]):
+                Client(f"{NS}/agent_{i}", timeout=5).update_configuration({"kappa": cls.kappa})
+            print(f"kappa set to {cls.kappa} at tick {cls.status[-1][1].step}", flush=True)
         name = os.path.basename(cls.path).replace(".yaml", "")
         cls.result = vf_rostest.wait_for_result(os.path.join(cls.out, name + ".result.yaml"), 50.0)
 
@@ -111,6 +129,16 @@ class TimedRun(unittest.TestCase):
             self.assertEqual(congruent[:5], [], "congruent beyond the delay margin")
             self.assertTrue(self.result.get("result") == "failed" or last.max_distance_error > 0.1,
                             f"result {self.result}, last max distance error {last.max_distance_error}")
+
+    def test_diagnostics(self):
+        self.assertEqual(sorted(self.diagnostics), [f"agent_{i}" for i in range(self.scenario["n"])])
+        expected = 1.0 / self.h  # rate 1
+        for who, statuses in self.diagnostics.items():
+            rates = [float(kv.value) for st in statuses for kv in st.values if kv.key == "step rate [1/s]"]
+            stepping = [r for r in rates if r > 0]
+            self.assertTrue(stepping, f"{who}: no step rate")
+            median = sorted(stepping)[len(stepping) // 2]
+            self.assertLess(abs(median - expected), 0.1 * expected, f"{who}: step rates {stepping}")
 
     def test_neighbours_hold_while_the_killed_agent_is_dead(self):
         if self.victim < 0:

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <dynamic_reconfigure/server.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <tf2_ros/transform_broadcaster.h>
@@ -12,6 +14,7 @@
 #include "variational_formation/AgentState.h"
 #include "variational_formation/RecallState.h"
 #include "variational_formation/RunProgress.h"
+#include "variational_formation/TimedAgentConfig.h"
 #include "variational_formation/core/link_faults.hpp"
 #include "variational_formation/core/timed_agent.hpp"
 
@@ -34,6 +37,12 @@ using variational_formation::RunProgress;
  * Robot mode (~robot true): the position comes from `odom` (nav_msgs/Odometry); the agent holds
  * until the first odometry, and sends the setpoint on `setpoint` (PoseStamped) and the commanded
  * velocity on `cmd_vel` (Twist). Topic names are relative: remap them to a real robot's.
+ *
+ * Diagnostics on /diagnostics (diagnostic_updater, about 1 Hz): step rate, each neighbour's age,
+ * accepted and dropped states, injected losses, held ticks; WARN while holding.
+ *
+ * dynamic_reconfigure (`rosrun dynamic_reconfigure dynparam set /formation/agent_0 kappa 6`): kappa,
+ * starting from the scenario's; lockstep keeps it fixed, so that it stays bit for bit exact.
  *
  * Private parameters: ~id, ~scenario (required), ~real_time_factor (> 0), ~monitor ("monitor"),
  * ~delay, ~jitter [s] (0), ~loss (0, probability), ~seed (id), ~max_age [s] (0.5), ~robot (false).
@@ -60,6 +69,8 @@ class TimedAgentNode {
   void recover();
   bool onRecall(RecallState::Request& request, RecallState::Response& response);
   double now() const { return ros::WallTime::now().toSec(); }
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
+  void onReconfigure(variational_formation::TimedAgentConfig& config, uint32_t level);
 
   ros::NodeHandle nh_;
   std::unique_ptr<TimedAgent> agent_;
@@ -82,6 +93,10 @@ class TimedAgentNode {
   long dropped_ = 0;
   int exitStatus_ = -1;  // -1: running
   ros::WallTime lastReportAt_, lastPublishAt_;
+  diagnostic_updater::Updater diagnostics_;
+  long diagnosedStep_ = 0;
+  double diagnosedAt_ = 0.0;
+  std::unique_ptr<dynamic_reconfigure::Server<variational_formation::TimedAgentConfig>> reconfigure_;
   std::string name_, frame_;
 };
 
