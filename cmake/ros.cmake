@@ -46,7 +46,7 @@ if(CATKIN_ENABLE_TESTING)
   foreach(case "case:=no_faults" "case:=faults delay:=0.05 jitter:=0.02 loss:=0.2"
                "case:=within_margin scenario_name:=timed_hexagon_kappa4"
                "case:=beyond_margin scenario_name:=timed_hexagon_kappa4 expect:=not_converged delay:=0.07"
-               "case:=kill kill:=2 max_age:=0.1"
+               "case:=kill kill:=2 respawn_delay:=1.5"
                "case:=reconfigure scenario_name:=timed_hexagon_kappa4 delay:=0.07 reconfigure_kappa:=13")
     separate_arguments(args UNIX_COMMAND "${case}")
     add_rostest(test/ros/timed_run.test ARGS ${args})

@@ -10,7 +10,7 @@ exit status 2.
 usage: make_agents_launch.py --scenario FILE --out FILE [--rate R] [--order forward|reverse]
                              [--stagger SECONDS] [--respawn true|false]
                              [--mode lockstep|timed [--delay S] [--jitter S] [--loss P] [--max-age S]
-                              [--seed N] [--robot true|false [--lag S] [--noise M]]]
+                              [--seed N] [--respawn-delay S] [--robot true|false [--lag S] [--noise M]]]
 With --robot true (timed mode), each agent also gets a simulated robot, robot_sim, in
 formation/robot_<id> (odom and cmd_vel there), started at the scenario's initial position.
 """
@@ -88,7 +88,8 @@ def timed_args(args, i):
     if args.mode != "timed":
         return ()
     # One fault stream per agent: seed + id.
-    return (("mode", "timed"), ("delay", args.delay), ("jitter", args.jitter), ("loss", args.loss),
+    return (("mode", "timed"), ("respawn_delay", args.respawn_delay), ("delay", args.delay),
+            ("jitter", args.jitter), ("loss", args.loss),
             ("max_age", args.max_age), ("seed", str(args.seed + i)), ("robot", args.robot)) + (
                 (("odom", f"robot_{i}/odom"), ("cmd_vel", f"robot_{i}/cmd_vel")) if args.robot == "true" else ())
 
@@ -124,6 +125,7 @@ def main():
     parser.add_argument("--max-age", type=positive("max_age"), default="0.5")
     parser.add_argument("--seed", type=seed, default=0)
     parser.add_argument("--robot", type=boolean("robot"), default="false")
+    parser.add_argument("--respawn-delay", type=non_negative("respawn_delay"), default="0")
     parser.add_argument("--lag", type=non_negative("lag"), default="0.1")
     parser.add_argument("--noise", type=non_negative("noise"), default="0.01")
     parser.error = lambda message: fail(message.replace("argument --", ""))

@@ -5,7 +5,7 @@ Private parameters:
   scenario    path of the scenario (required)
   expect      converged: the last status is congruent (and the run ends by itself);
               not_converged: no status is ever congruent (beyond the delay margin)
-  max_age     the agents' (a respawn takes about 0.4 s: the kill case uses 0.1 s to see holds)
+  max_age     the agents' (the kill case restarts the agent after respawn_delay 1.5 s)
   kill        >= 0: SIGKILL that agent's process 1 s into the run; its neighbours must hold
               (q_{k+1} = q_k exactly) while it is dead, it respawns, and the formation converges
   reconfigure_kappa  > 0: 2 s into the run, set every agent's kappa to it (dynamic_reconfigure)
@@ -149,10 +149,10 @@ class TimedRun(unittest.TestCase):
         self.assertTrue(back, "no state from the respawned agent")
         start, end = self.killed_at + self.max_age + 0.1, back[0] - 0.05
         print(f"agent_{self.victim}: first state {back[0] - self.killed_at:.2f} s after the kill", flush=True)
-        self.assertGreater(end - start, 0.1, "the agent came back too fast to see a hold")
+        self.assertGreater(end - start, 0.5, "the agent came back too fast to see a hold")
         for j in self.neighbours:
             during = [m for t, m in self.states.get(j, []) if start <= t <= end]
-            self.assertGreater(len(during), 5, f"agent_{j} published nothing while agent_{self.victim} was dead")
+            self.assertGreater(len(during), 20, f"agent_{j} published nothing while agent_{self.victim} was dead")
             moving = [m.step for m in during if list(m.position) != list(m.previous_position)]
             self.assertEqual(moving, [], f"agent_{j} moved while its neighbour was dead")
         # The monitor reported the dead agent's data as old: about as old as it was dead.
