@@ -2,6 +2,9 @@
 add_library(variational_formation_ros src/ros/agent_node.cpp src/ros/monitor_node.cpp src/ros/markers.cpp
   src/ros/participants.cpp
   src/ros/recorder_node.cpp)
+# The time-driven agent (doc/robots.md), selected by the agent's ~mode.
+target_sources(variational_formation_ros PRIVATE src/ros/timed_agent_node.cpp)
+add_dependencies(variational_formation_ros ${PROJECT_NAME}_gencfg)
 target_include_directories(variational_formation_ros SYSTEM PUBLIC ${catkin_INCLUDE_DIRS})
 target_link_libraries(variational_formation_ros variational_formation_core ${catkin_LIBRARIES})
 target_compile_options(variational_formation_ros PRIVATE ${VF_FLAGS})
@@ -39,6 +42,17 @@ if(CATKIN_ENABLE_TESTING)
     separate_arguments(args UNIX_COMMAND "${case}")
     add_rostest(test/ros/fault.test ARGS ${args})
   endforeach()
+  # Time-driven agents (test/ros/timed_run.test), hexagon at rate 1.
+  foreach(case "case:=no_faults" "case:=faults delay:=0.05 jitter:=0.02 loss:=0.2"
+               "case:=within_margin scenario_name:=timed_hexagon_kappa4"
+               "case:=beyond_margin scenario_name:=timed_hexagon_kappa4 expect:=not_converged delay:=0.07"
+               "case:=kill kill:=2 respawn_delay:=1.5"
+               "case:=reconfigure scenario_name:=timed_hexagon_kappa4 delay:=0.07 reconfigure_kappa:=13")
+    separate_arguments(args UNIX_COMMAND "${case}")
+    add_rostest(test/ros/timed_run.test ARGS ${args})
+  endforeach()
+  add_rostest(test/ros/timed_bad_input.test)
+  add_rostest(test/ros/robots_run.test)
   foreach(t two_formations launch)
     add_rostest(test/ros/${t}.test)
   endforeach()

@@ -21,6 +21,8 @@ VF_APT_PACKAGES=(
   python3-matplotlib python3-numpy python3-yaml xvfb x11-apps python3-tf2-ros
   python3-rosparam python3-rospkg ros-nav-msgs libnav-msgs-dev python3-nav-msgs python3-setuptools
   python3-rosunit iproute2
+  libdiagnostic-updater-dev python3-dynamic-reconfigure libdynamic-reconfigure-config-init-mutex-dev
+  python3-diagnostic-msgs
 )
 
 vf_install_dependencies() {

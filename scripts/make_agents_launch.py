@@ -9,6 +9,10 @@ exit status 2.
 
 usage: make_agents_launch.py --scenario FILE --out FILE [--rate R] [--order forward|reverse]
                              [--stagger SECONDS] [--respawn true|false]
+                             [--mode lockstep|timed [--delay S] [--jitter S] [--loss P] [--max-age S]
+                              [--seed N] [--respawn-delay S] [--robot true|false [--lag S] [--noise M]]]
+With --robot true (timed mode), each agent also gets a simulated robot, robot_sim, in
+formation/robot_<id> (odom and cmd_vel there), started at the scenario's initial position.
 """
 import argparse
 import math
@@ -16,6 +20,8 @@ import os
 import subprocess
 import sys
 from xml.sax.saxutils import quoteattr
+
+import yaml
 
 
 def fail(message):
@@ -45,6 +51,30 @@ def boolean(flag):
     return parse
 
 
+def probability(flag):
+    def parse(text):
+        non_negative(flag)(text)
+        if float(text) > 1:
+            fail(f"{flag}: must be a probability in [0, 1], got {text}")
+        return text
+    return parse
+
+
+def positive(flag):
+    def parse(text):
+        non_negative(flag)(text)
+        if float(text) <= 0:
+            fail(f"{flag}: must be > 0, got {text}")
+        return text
+    return parse
+
+
+def seed(text):
+    if not text.isdigit():
+        fail(f"seed: must be an integer >= 0, got '{text}'")
+    return int(text)
+
+
 def agent_count(scenario, rate):
     info = subprocess.run(["rosrun", "variational_formation", "scenario_info", "--scenario", scenario,
                            "--real-time-factor", rate], capture_output=True, text=True)
@@ -52,6 +82,31 @@ def agent_count(scenario, rate):
         lines = info.stderr.strip().splitlines() or ["scenario_info failed"]
         fail(lines[-1].replace("scenario_info: error: ", ""))
     return int(info.stdout.split()[1])
+
+
+def timed_args(args, i):
+    if args.mode != "timed":
+        return ()
+    # One fault stream per agent: seed + id.
+    return (("mode", "timed"), ("respawn_delay", args.respawn_delay), ("delay", args.delay),
+            ("jitter", args.jitter), ("loss", args.loss),
+            ("max_age", args.max_age), ("seed", str(args.seed + i)), ("robot", args.robot)) + (
+                (("odom", f"robot_{i}/odom"), ("cmd_vel", f"robot_{i}/cmd_vel")) if args.robot == "true" else ())
+
+
+def robot_sim(args, i):
+    """A simulated robot for agent i, at the scenario's initial position (the loader checked it)."""
+    with open(args.scenario) as f:
+        agent = next(a for a in yaml.safe_load(f)["agents"] if int(a["id"]) == i)
+    start = ", ".join(repr(float(x)) for x in agent["initial_position"])
+    return [f'  <node name="robot_sim" ns="formation/robot_{i}" pkg="variational_formation" type="robot_sim" '
+            'output="screen">',
+            f'    <param name="id" type="int" value="{i}"/>',
+            f'    <rosparam param="initial_position">[{start}]</rosparam>',
+            f'    <param name="lag" type="double" value="{args.lag}"/>',
+            f'    <param name="odometry_noise" type="double" value="{args.noise}"/>',
+            f'    <param name="seed" type="int" value="{args.seed + i}"/>',
+            "  </node>"]
 
 
 def main():
@@ -62,8 +117,23 @@ def main():
     parser.add_argument("--order", choices=("forward", "reverse"), default="forward")
     parser.add_argument("--stagger", type=non_negative("stagger"), default="0")
     parser.add_argument("--respawn", type=boolean("respawn"), default="true")
+    # Timed mode (doc/robots.md): passed to the agents only then, so lockstep files stay as they were.
+    parser.add_argument("--mode", choices=("lockstep", "timed"), default="lockstep")
+    parser.add_argument("--delay", type=non_negative("delay"), default="0")
+    parser.add_argument("--jitter", type=non_negative("jitter"), default="0")
+    parser.add_argument("--loss", type=probability("loss"), default="0")
+    parser.add_argument("--max-age", type=positive("max_age"), default="0.5")
+    parser.add_argument("--seed", type=seed, default=0)
+    parser.add_argument("--robot", type=boolean("robot"), default="false")
+    parser.add_argument("--respawn-delay", type=non_negative("respawn_delay"), default="0")
+    parser.add_argument("--lag", type=non_negative("lag"), default="0.1")
+    parser.add_argument("--noise", type=non_negative("noise"), default="0.01")
     parser.error = lambda message: fail(message.replace("argument --", ""))
     args = parser.parse_args()
+    if args.robot == "true" and args.mode != "timed":
+        fail("robot: robots need mode timed")
+    if args.mode == "timed" and float(args.rate) <= 0:
+        fail(f"rate: must be > 0 in timed mode (the tick period is h / rate), got {args.rate}")
     count = agent_count(args.scenario, args.rate)
     ids = list(range(count))
     if args.order == "reverse":
@@ -75,9 +145,11 @@ def main():
         prefix = f"bash -c 'sleep {delay:g}; exec \"$0\" \"$@\"'" if delay > 0 else ""
         lines.append('  <include file="$(find variational_formation)/launch/agent.launch">')
         for name, value in (("id", str(i)), ("scenario", args.scenario), ("rate", args.rate),
-                            ("respawn", args.respawn), ("launch_prefix", prefix)):
+                            ("respawn", args.respawn), ("launch_prefix", prefix)) + timed_args(args, i):
             lines.append(f"    <arg name={quoteattr(name)} value={quoteattr(value)}/>")
         lines.append("  </include>")
+        if args.robot == "true":
+            lines += robot_sim(args, i)
     lines.append("</launch>")
     try:
         os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)

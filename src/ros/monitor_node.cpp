@@ -1,11 +1,14 @@
 #include "variational_formation/ros/monitor_node.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
+#include <limits>
 
 #include <ros/callback_queue.h>
 #include <ros/master.h>
 
+#include "variational_formation/core/number_checks.hpp"
 #include "variational_formation/ros/markers.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/participants.hpp"
@@ -38,6 +41,16 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   if (trailLength_ < 2) throw InvalidInput("~trail_length: must be >= 2");
   if (window_ < 1) throw InvalidInput("~window: must be >= 1, got " + std::to_string(window_));
   if (!(respawnTimeout_ >= 0.0)) throw InvalidInput("~respawn_timeout: must be >= 0");
+  const std::string mode = optionalParam<std::string>(pnh, "mode", "lockstep");
+  if (mode != "lockstep" && mode != "timed") {
+    throw InvalidInput("~mode: must be lockstep or timed, got '" + mode + "'");
+  }
+  timed_ = mode == "timed";
+  if (timed_) {
+    rate_ = optionalParam(pnh, "real_time_factor", 0.0);
+    requireFiniteAbove("~real_time_factor (timed mode: the status period is h / rate)", rate_, 0.0, "");
+    if (!recorder.empty()) throw InvalidInput("~recorder: recording is for lockstep mode; timed mode has none");
+  }
   monitor_ = std::make_unique<FormationMonitor>(loadScenario(path));
   const int n = monitor_->formation().agentCount();
   trails_.resize(static_cast<std::size_t>(n));
@@ -92,6 +105,12 @@ void MonitorNode::onState(int agent, const ros::MessageEvent<AgentState const>& 
   } else if (!msg.failure.empty()) {
     finish(RunProgress::FAILED, owner.node + ": " + msg.failure);
     return;
+  } else if (timed_) {
+    if (acceptTimed(agent, msg, why)) {
+      owner.seen = true;
+      owner.goneSince = ros::WallTime();
+      return;
+    }
   } else {
     try {
       const auto receipt = monitor_->add(agent, msg.step, msg.position, msg.previous_position, acceptUpTo_);
@@ -149,6 +168,14 @@ void MonitorNode::publishCompleted() {
     FormationStatus status = toStatusMessage(s);
     status.header.stamp = stamp;
     status.dropped = static_cast<uint32_t>(dropped_);
+    status.max_data_age = dataAge_;
+    if (timed_) {
+      // Noether's laws are those of one synchronous run; the time-driven agents are not that.
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      status.linear_momentum_predicted.x = status.linear_momentum_predicted.y = status.linear_momentum_predicted.z = nan;
+      status.angular_momentum_predicted.x = status.angular_momentum_predicted.y = nan;
+      status.angular_momentum_predicted.z = nan;
+    }
     statusPub_.publish(status);
     visualization_msgs::MarkerArray markers = makeMarkers(s, monitor_->formation(), trails_);
     for (auto& m : markers.markers) m.header.stamp = stamp;
@@ -236,6 +263,10 @@ bool MonitorNode::checkAlive(Participant& p, const std::string& what, double tim
 
 void MonitorNode::watch() {
   if (exitStatus_ >= 0) return;
+  if (timed_) {
+    watchTimed();
+    return;
+  }
   const ros::WallTime since = lastCompletedAt_.isZero() ? startedAt_ : lastCompletedAt_;
   const double stalled = since.isZero() ? kCheckAfter : secondsSince(since);
   if (stalled >= kCheckAfter) {
@@ -369,10 +400,74 @@ void MonitorNode::recover() {
   publishCompleted();
 }
 
+bool MonitorNode::acceptTimed(int agent, const AgentState& msg, std::string& why) {
+  const std::size_t d = static_cast<std::size_t>(monitor_->scenario().dimension);
+  bool finite = msg.position.size() == d && msg.previous_position.size() == d;
+  for (std::size_t a = 0; finite && a < d; ++a) finite = std::isfinite(msg.position[a]) && std::isfinite(msg.previous_position[a]);
+  if (!finite) {
+    why = "(step " + std::to_string(msg.step) + "): wrong dimension or not finite";
+    return false;
+  }
+  AgentState& newest = newest_[static_cast<std::size_t>(agent)];
+  const double now = ros::WallTime::now().toSec();
+  double& at = receivedAt_[static_cast<std::size_t>(agent)];
+  // A respawned agent may restart from a lower step once its old state is stale.
+  if (msg.step > newest.step || now - at > kCheckAfter) {
+    newest = msg;
+    at = now;
+  }
+  return true;
+}
+
+void MonitorNode::tickTimed() {
+  if (exitStatus_ >= 0) return;
+  for (const AgentState& s : newest_) {
+    if (s.step < 0) return;  // not every agent is there yet: the run has not started
+  }
+  ++tick_;
+  const double now = ros::WallTime::now().toSec();
+  dataAge_ = 0.0;
+  bool allDone = monitor_->scenario().steps > 0;
+  for (std::size_t i = 0; i < newest_.size(); ++i) {
+    const AgentState& s = newest_[i];
+    dataAge_ = std::max(dataAge_, now - receivedAt_[i]);
+    allDone = allDone && s.step >= monitor_->scenario().steps;
+    // The monitor's own step is its tick: it measures the newest state of every agent.
+    monitor_->add(static_cast<long>(i), tick_, s.position, s.previous_position, tick_);
+  }
+  publishCompleted();
+  if (allDone && exitStatus_ < 0) finish(RunProgress::FINISHED, "");
+}
+
+void MonitorNode::watchTimed() {
+  const double now = ros::WallTime::now().toSec();
+  for (std::size_t i = 0; i < agents_.size(); ++i) {
+    if (agents_[i].seen && now - receivedAt_[i] >= kCheckAfter &&
+        !checkAlive(agents_[i], "agent_" + std::to_string(i), respawnTimeout_)) {
+      return;
+    }
+  }
+  if (tick_ < 0 && secondsSince(lastReportAt_) >= kReportEvery) {
+    std::vector<int> unseen;
+    for (std::size_t i = 0; i < agents_.size(); ++i) {
+      if (newest_[i].step < 0) unseen.push_back(static_cast<int>(i));
+    }
+    ROS_INFO("monitor: timed mode, waiting for the first state of %s", agentList(unseen).c_str());
+    lastReportAt_ = ros::WallTime::now();
+  }
+}
+
 int MonitorNode::run() {
-  recover();
+  if (!timed_) recover();
   lastReportAt_ = ros::WallTime::now();
   progressPub_.publish(progress_);
+  if (timed_) {
+    receivedAt_.assign(newest_.size(), 0.0);
+    tickTimer_ = nh_.createWallTimer(ros::WallDuration(monitor_->scenario().timeStep / rate_),
+                                     [this](const ros::WallTimerEvent&) { tickTimed(); });
+    ROS_INFO("monitor: timed mode: status every %g s from each agent's newest state; the Noether predictions do "
+             "not hold in this mode (published as NaN)", monitor_->scenario().timeStep / rate_);
+  }
   watchTimer_ = nh_.createWallTimer(ros::WallDuration(0.5), [this](const ros::WallTimerEvent&) { watch(); });
   auto* queue = ros::getGlobalCallbackQueue();
   while (ros::ok() && exitStatus_ < 0) queue->callAvailable(ros::WallDuration(0.1));

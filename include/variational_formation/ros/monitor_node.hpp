@@ -37,6 +37,13 @@ using variational_formation::RunProgress;
  * with true, the start also waits for a subscriber of `markers`, i.e. rviz), ~respawn_timeout
  * (seconds a dead agent may take to come back before the run fails; 0 = fail at once).
  *
+ * Timed mode (~mode timed, ~real_time_factor > 0; doc/robots.md): the agents do not wait for each
+ * other, so there are no completed steps to wait for. Once every agent's first state is there it
+ * starts the run, then measures the newest state of every agent on a wall-clock timer of period
+ * h / rate (its own step count is the timer's) and reports the age of the oldest data it used
+ * (`max_data_age`). The run ends after the scenario's steps of that timer, or when every agent
+ * has reached them. The Noether predictions do not hold there: they are published as NaN.
+ *
  * Recovery: it serves `~recall` (each agent's newest state, for a restarted agent), and when it
  * starts in the middle of a run it rebuilds the steps it had not completed from the agents'
  * `~history` and goes on from there.
@@ -67,6 +74,10 @@ class MonitorNode {
   std::string waitingFor() const;
   void finish(uint8_t state, const std::string& reason);
   void writeResult(const std::string& result, const std::string& reason) const;
+  // Timed mode.
+  bool acceptTimed(int agent, const AgentState& msg, std::string& why);
+  void tickTimed();
+  void watchTimed();
   long completedStep() const { return monitor_->nextStep() - 1; }
 
   ros::NodeHandle nh_;
@@ -98,6 +109,13 @@ class MonitorNode {
   long convergedStep_ = -1;
   ros::WallTime firstStepAt_, lastCompletedAt_, lastReportAt_, startedAt_;
   int exitStatus_ = -1;
+  // Timed mode.
+  bool timed_ = false;
+  double rate_ = 0.0;
+  std::vector<double> receivedAt_;  // wall time [s] of each agent's newest state
+  ros::WallTimer tickTimer_;
+  long tick_ = -1;
+  double dataAge_ = 0.0;            // of the oldest state used by the newest status [s]
 };
 
 }  // namespace vf

@@ -1,0 +1,103 @@
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <dynamic_reconfigure/server.h>
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+#include <tf2_ros/transform_broadcaster.h>
+
+#include "variational_formation/AgentState.h"
+#include "variational_formation/RecallState.h"
+#include "variational_formation/RunProgress.h"
+#include "variational_formation/TimedAgentConfig.h"
+#include "variational_formation/core/link_faults.hpp"
+#include "variational_formation/core/timed_agent.hpp"
+
+namespace vf {
+
+using variational_formation::AgentState;
+using variational_formation::RecallState;
+using variational_formation::RunProgress;
+
+/**
+ * ROS I/O of one agent in time-driven mode (doc/robots.md). A wall-clock timer of period h/rate
+ * calls TimedAgent::tick with the newest neighbour states it holds; it never waits. Received
+ * neighbour states (only from the node that owns them) go through LinkFaults (injected delay,
+ * jitter, loss) before the agent sees them. All maths is TimedAgent's.
+ *
+ * It starts when the monitor's latched `progress` allows step 1 (as in lockstep) and ignores
+ * the flow-control window afterwards. A respawned agent asks its neighbours and the monitor for
+ * its newest state (`~recall`, as in lockstep) and restarts from it at rest.
+ *
+ * Robot mode (~robot true): the position comes from `odom` (nav_msgs/Odometry); the agent holds
+ * until the first odometry, and sends the setpoint on `setpoint` (PoseStamped) and the commanded
+ * velocity on `cmd_vel` (Twist). Topic names are relative: remap them to a real robot's.
+ *
+ * Diagnostics on /diagnostics (diagnostic_updater, about 1 Hz): step rate, each neighbour's age,
+ * accepted and dropped states, injected losses, held ticks; WARN while holding.
+ *
+ * dynamic_reconfigure (`rosrun dynamic_reconfigure dynparam set /formation/agent_0 kappa 6`): kappa,
+ * starting from the scenario's; lockstep keeps it fixed, so that it stays bit for bit exact.
+ *
+ * Private parameters: ~id, ~scenario (required), ~real_time_factor (> 0), ~monitor ("monitor"),
+ * ~delay, ~jitter [s] (0), ~loss (0, probability), ~seed (id), ~max_age [s] (0.5), ~robot (false).
+ */
+class TimedAgentNode {
+ public:
+  /// @throws InvalidInput on a missing or bad parameter or scenario.
+  TimedAgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  /// Spins until shutdown. @return 0, or 1 if the monitor said the run failed.
+  int run();
+
+ private:
+  struct Received {
+    int sender;
+    AgentState state;
+  };
+  void onNeighbourState(int neighbour, const ros::MessageEvent<AgentState const>& event);
+  void onProgress(const ros::MessageEvent<RunProgress const>& event);
+  void onOdometry(const nav_msgs::Odometry& odom);
+  void onTick();
+  void publish();
+  void reportWaiting();
+  void drop(const std::string& why);
+  void recover();
+  bool onRecall(RecallState::Request& request, RecallState::Response& response);
+  double now() const { return ros::WallTime::now().toSec(); }
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
+  void onReconfigure(variational_formation::TimedAgentConfig& config, uint32_t level);
+
+  ros::NodeHandle nh_;
+  std::unique_ptr<TimedAgent> agent_;
+  std::unique_ptr<LinkFaults<Received>> faults_;
+  ros::Publisher statePub_, posePub_, setpointPub_, cmdVelPub_;
+  std::vector<ros::Subscriber> subs_;
+  std::vector<std::string> neighbourOwners_;  // full node names, indexed like neighbourIds()
+  std::map<int, AgentState> newest_;          // each neighbour's newest accepted state, for ~recall
+  ros::Subscriber progressSub_, odomSub_;
+  ros::ServiceServer recallServer_;
+  std::string monitor_;
+  tf2_ros::TransformBroadcaster tf_;
+  ros::WallTimer tickTimer_, watchTimer_;
+  double rate_ = 0.0;
+  double h_ = 0.0;
+  bool robot_ = false;
+  bool haveOdometry_ = false;
+  std::vector<double> measured_;
+  bool running_ = false;
+  long dropped_ = 0;
+  int exitStatus_ = -1;  // -1: running
+  ros::WallTime lastReportAt_, lastPublishAt_;
+  diagnostic_updater::Updater diagnostics_;
+  long diagnosedStep_ = 0;
+  double diagnosedAt_ = 0.0;
+  std::unique_ptr<dynamic_reconfigure::Server<variational_formation::TimedAgentConfig>> reconfigure_;
+  std::string name_, frame_;
+};
+
+}  // namespace vf

@@ -1,0 +1,349 @@
+#include "variational_formation/ros/timed_agent_node.hpp"
+
+#include <cmath>
+
+#include <geometry_msgs/PoseStamped.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <geometry_msgs/Twist.h>
+#include <ros/callback_queue.h>
+
+#include "variational_formation/core/number_checks.hpp"
+#include "variational_formation/core/validation.hpp"
+#include "variational_formation/ros/parameters.hpp"
+#include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/service_call.hpp"
+
+namespace vf {
+
+namespace {
+constexpr double kReportEvery = 5.0;  // seconds between "waiting for ..." lines
+constexpr double kHoldReportEvery = 2.0;
+}  // namespace
+
+TimedAgentNode::TimedAgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), diagnostics_(nh, pnh) {
+  const int id = requiredParam<int>(pnh, "id");
+  const std::string path = requiredParam<std::string>(pnh, "scenario");
+  rate_ = optionalParam(pnh, "real_time_factor", 0.0);
+  requireFiniteAbove("~real_time_factor (timed mode: the tick period is h / rate)", rate_, 0.0, "");
+  monitor_ = participantName(nh, optionalParam<std::string>(pnh, "monitor", "monitor"));
+  LinkFaultSettings faults;
+  faults.delay = optionalParam(pnh, "delay", 0.0);
+  faults.jitter = optionalParam(pnh, "jitter", 0.0);
+  faults.loss = optionalParam(pnh, "loss", 0.0);
+  try {
+    validateLinkFaults(faults);
+  } catch (const InvalidInput& e) {
+    throw InvalidInput(std::string("~") + e.what());  // name the parameter
+  }
+  const int seed = optionalParam(pnh, "seed", id);
+  if (seed < 0) throw InvalidInput("~seed: must be >= 0, got " + std::to_string(seed));
+  const double maxAge = optionalParam(pnh, "max_age", 0.5);
+  requireFiniteAbove("~max_age", maxAge, 0.0, "s");
+  robot_ = optionalParam(pnh, "robot", false);
+  const Scenario scenario = loadScenario(path);
+  validateRealTimeFactor(rate_, scenario.timeStep, "~real_time_factor");
+  agent_ = std::make_unique<TimedAgent>(scenario, id, maxAge);
+  faults_ = std::make_unique<LinkFaults<Received>>(faults, static_cast<std::uint64_t>(seed));
+  h_ = scenario.timeStep;
+  name_ = "agent_" + std::to_string(id);
+  const std::string ns = nh.getNamespace() == "/" ? "" : nh.getNamespace().substr(1) + "/";
+  frame_ = ns + name_;
+  statePub_ = nh.advertise<AgentState>(name_ + "/state", 100, /*latch=*/true);
+  posePub_ = nh.advertise<geometry_msgs::PoseStamped>(name_ + "/pose", 10);
+  for (int j : agent_->neighbourIds()) {
+    neighbourOwners_.push_back(agentNodeName(nh, j));
+    subs_.push_back(nh.subscribe<AgentState>(
+        "agent_" + std::to_string(j) + "/state", 100,
+        boost::function<void(const ros::MessageEvent<AgentState const>&)>(
+            [this, j](const ros::MessageEvent<AgentState const>& e) { onNeighbourState(j, e); }),
+        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
+  }
+  progressSub_ = nh.subscribe<RunProgress>(
+      "progress", 10,
+      boost::function<void(const ros::MessageEvent<RunProgress const>&)>(
+          [this](const ros::MessageEvent<RunProgress const>& e) { onProgress(e); }),
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  if (robot_) {
+    // Relative names in the node's private namespace' parent: remap them to a real robot's.
+    odomSub_ = pnh.subscribe("odom", 10, &TimedAgentNode::onOdometry, this, ros::TransportHints().tcpNoDelay());
+    setpointPub_ = pnh.advertise<geometry_msgs::PoseStamped>("setpoint", 10);
+    cmdVelPub_ = pnh.advertise<geometry_msgs::Twist>("cmd_vel", 10);
+  }
+  recallServer_ = nh.advertiseService(name_ + "/recall", &TimedAgentNode::onRecall, this);
+  // The server starts from ~kappa: the scenario's (an earlier value would be another run's).
+  pnh.setParam("kappa", scenario.dampingGain);
+  reconfigure_ = std::make_unique<dynamic_reconfigure::Server<variational_formation::TimedAgentConfig>>(pnh);
+  reconfigure_->setCallback(
+      [this](variational_formation::TimedAgentConfig& config, uint32_t level) { onReconfigure(config, level); });
+  diagnostics_.setHardwareID(frame_);
+  diagnostics_.add("timed agent", this, &TimedAgentNode::diagnose);
+  for (const std::string& w : scenario.warnings) ROS_WARN("%s: %s", name_.c_str(), w.c_str());
+  ROS_INFO("%s: timed mode, scenario '%s' (%s), %d neighbours, kappa %g, h %g, tick %g s, delay %g s, jitter %g s, "
+           "loss %g, seed %d, max_age %g s%s, monitor %s",
+           name_.c_str(), scenario.name.c_str(), path.c_str(), static_cast<int>(agent_->neighbourIds().size()),
+           scenario.dampingGain, h_, h_ / rate_, faults.delay, faults.jitter, faults.loss, seed, maxAge,
+           robot_ ? (", robot mode (odom " + odomSub_.getTopic() + ")").c_str() : "", monitor_.c_str());
+}
+
+void TimedAgentNode::drop(const std::string& why) {
+  ++dropped_;
+  ROS_WARN_THROTTLE(1.0, "%s: dropped %s; %ld dropped so far", name_.c_str(), why.c_str(), dropped_);
+}
+
+void TimedAgentNode::onNeighbourState(int neighbour, const ros::MessageEvent<AgentState const>& event) {
+  std::size_t k = 0;
+  while (agent_->neighbourIds()[k] != neighbour) ++k;
+  if (!fromOwner(event, neighbourOwners_[k])) {
+    drop("a state on agent_" + std::to_string(neighbour) + "'s topic from " + event.getPublisherName() +
+         ", which does not own it");
+    return;
+  }
+  const AgentState& msg = *event.getConstMessage();
+  // The id check is the core's (UnknownSender); the faults act on what the network delivered.
+  faults_->offer({static_cast<int>(msg.id) == neighbour ? neighbour : -1, msg}, now());
+}
+
+void TimedAgentNode::onProgress(const ros::MessageEvent<RunProgress const>& event) {
+  if (!fromOwner(event, monitor_)) {
+    drop("a progress message from " + event.getPublisherName() + ", which is not the monitor " + monitor_);
+    return;
+  }
+  const RunProgress& p = *event.getConstMessage();
+  if (p.state == RunProgress::FINISHED || p.state == RunProgress::FAILED) {
+    if (exitStatus_ < 0) {
+      ROS_INFO("%s: the run is over at step %ld (%s); %ld ticks held, %ld neighbour states lost (injected), %ld "
+               "outdated or refused; idle until shut down",
+               name_.c_str(), agent_->step(),
+               p.state == RunProgress::FINISHED ? "finished" : ("failed: " + p.reason).c_str(), agent_->heldTicks(),
+               faults_->lost(), agent_->dropped());
+    }
+    exitStatus_ = p.state == RunProgress::FINISHED ? 0 : 1;
+    running_ = false;
+    if (robot_) cmdVelPub_.publish(geometry_msgs::Twist());
+  } else if (!running_ && exitStatus_ < 0 && p.state == RunProgress::RUNNING && p.allowed_step >= 1) {
+    // Start by identity, as in lockstep; afterwards the flow-control window is ignored.
+    running_ = true;
+    ROS_INFO("%s: the monitor started the run; ticking every %g s from step %ld", name_.c_str(), h_ / rate_,
+             agent_->step());
+  }
+}
+
+void TimedAgentNode::onOdometry(const nav_msgs::Odometry& odom) {
+  const auto& p = odom.pose.pose.position;
+  const std::size_t d = agent_->position().size();
+  std::vector<double> q = {p.x, p.y, p.z};
+  q.resize(d);
+  measured_ = q;
+  if (!haveOdometry_) ROS_INFO("%s: first odometry on %s", name_.c_str(), odomSub_.getTopic().c_str());
+  haveOdometry_ = true;
+}
+
+void TimedAgentNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  const double t = now();
+  const double rate = diagnosedAt_ > 0.0 && t > diagnosedAt_ ? (agent_->step() - diagnosedStep_) / (t - diagnosedAt_) : 0.0;
+  diagnosedStep_ = agent_->step();
+  diagnosedAt_ = t;
+  if (exitStatus_ >= 0 || agent_->finished()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "run over");
+  } else if (!running_) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "waiting for the monitor to start the run");
+  } else if (robot_ && !haveOdometry_) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "holding: no odometry yet");
+  } else if (agent_->holding()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "holding: a neighbour is silent");
+  } else {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "stepping");
+  }
+  status.add("step", agent_->step());
+  status.add("step rate [1/s]", rate);
+  status.add("expected step rate [1/s]", rate_ / h_);
+  status.add("holding", agent_->holding());
+  status.add("held ticks", agent_->heldTicks());
+  status.add("states lost (injected)", faults_->lost());
+  status.add("states refused (outdated or malformed)", agent_->dropped());
+  status.add("states dropped (not from the owner)", dropped_);
+  status.add("kappa [1/s]", agent_->dampingGain());
+  for (const TimedAgent::NeighbourStatus& n : agent_->neighbourStatus(t)) {
+    const std::string who = "agent_" + std::to_string(n.id);
+    status.add(who + " age [s]", n.heard ? n.age : -1.0);
+    status.add(who + " accepted", n.accepted);
+    status.add(who + " dropped", n.dropped);
+  }
+}
+
+void TimedAgentNode::onReconfigure(variational_formation::TimedAgentConfig& config, uint32_t) {
+  if (config.kappa == agent_->dampingGain()) return;
+  try {
+    agent_->setDampingGain(config.kappa);
+    ROS_INFO("%s: kappa set to %g at step %ld", name_.c_str(), config.kappa, agent_->step());
+  } catch (const std::exception& e) {
+    ROS_WARN("%s: kappa not changed: %s", name_.c_str(), e.what());
+    config.kappa = agent_->dampingGain();
+  }
+}
+
+void TimedAgentNode::onTick() {
+  diagnostics_.update();  // rate-limited by the updater itself (~diagnostic_period, 1 s)
+  const double t = now();
+  for (Received& r : faults_->takeDue(t)) {
+    const AgentState& s = r.state;
+    try {
+      const auto receipt = agent_->receive(r.sender, s.step, s.position, s.previous_position, t);
+      if (receipt == TimedAgent::Receipt::Accepted) {
+        newest_[r.sender] = s;
+      } else if (receipt != TimedAgent::Receipt::Outdated) {
+        drop("a state on agent_" + std::to_string(s.id) + "'s topic (step " + std::to_string(s.step) +
+             "): " + TimedAgent::describe(receipt));
+      }
+    } catch (const std::exception& e) {
+      drop(std::string("a state: ") + e.what());
+    }
+  }
+  if (robot_ && !haveOdometry_) {
+    ROS_WARN_THROTTLE(kReportEvery, "%s: holding: no odometry on %s yet", name_.c_str(), odomSub_.getTopic().c_str());
+    return;
+  }
+  if (!running_ && exitStatus_ < 0 && secondsSince(lastPublishAt_) > 0.25 * agent_->maxAge()) {
+    // Before the start, keep the neighbours' copy of our first state fresh: else they would
+    // find it older than max_age at their first tick and hold once.
+    publish();
+  }
+  if (!running_ || agent_->finished()) return;
+  if (robot_) agent_->setMeasuredPosition(measured_);
+  const TimedAgent::TickResult result = agent_->tick(t);
+  if (result.holding) {
+    std::string who;
+    for (const auto& s : result.stale) {
+      char age[64];
+      if (s.heard) {
+        std::snprintf(age, sizeof age, "silent for %.2f s", s.age);
+      } else {
+        std::snprintf(age, sizeof age, "never heard");
+      }
+      who += (who.empty() ? "" : ", ") + std::string("agent_") + std::to_string(s.id) + " " + age;
+    }
+    ROS_WARN_THROTTLE(kHoldReportEvery, "%s: holding at step %ld: %s (max_age %g s)", name_.c_str(), result.step,
+                      who.c_str(), agent_->maxAge());
+  }
+  for (double x : agent_->position()) {
+    if (!std::isfinite(x)) {
+      ROS_ERROR("%s: step %ld is not finite (the formation diverged); stopping", name_.c_str(), agent_->step());
+      running_ = false;
+      AgentState msg;
+      msg.id = static_cast<uint32_t>(agent_->id());
+      msg.step = agent_->step();
+      msg.failure = "step " + std::to_string(agent_->step()) + " is not finite (the run diverged)";
+      msg.position.assign(agent_->position().size(), 0.0);
+      msg.previous_position = msg.position;
+      statePub_.publish(msg);
+      return;
+    }
+  }
+  publish();
+  if (robot_ && agent_->finished()) cmdVelPub_.publish(geometry_msgs::Twist());  // our last step: stop the robot
+}
+
+void TimedAgentNode::publish() {
+  AgentState msg;
+  msg.header.stamp.fromSec(agent_->step() * h_);  // the simulated time of the step
+  msg.header.frame_id = "world";
+  msg.id = static_cast<uint32_t>(agent_->id());
+  msg.step = agent_->step();
+  msg.time = agent_->step() * h_;
+  msg.position = agent_->position();
+  msg.previous_position = agent_->previousPosition();
+  msg.dropped = static_cast<uint32_t>(dropped_ + agent_->dropped());
+  statePub_.publish(msg);
+  lastPublishAt_ = ros::WallTime::now();
+
+  geometry_msgs::PoseStamped pose;
+  pose.header = msg.header;
+  pose.pose.position.x = msg.position[0];
+  pose.pose.position.y = msg.position[1];
+  pose.pose.position.z = msg.position.size() > 2 ? msg.position[2] : 0.0;
+  pose.pose.orientation.w = 1.0;
+  posePub_.publish(pose);
+
+  geometry_msgs::TransformStamped t;
+  t.header = msg.header;
+  t.child_frame_id = frame_;
+  t.transform.translation.x = pose.pose.position.x;
+  t.transform.translation.y = pose.pose.position.y;
+  t.transform.translation.z = pose.pose.position.z;
+  t.transform.rotation.w = 1.0;
+  tf_.sendTransform(t);
+
+  if (robot_) {
+    setpointPub_.publish(pose);
+    geometry_msgs::Twist cmd;
+    const std::vector<double>& v = agent_->commandedVelocity();
+    cmd.linear.x = v[0];
+    cmd.linear.y = v[1];
+    cmd.linear.z = v.size() > 2 ? v[2] : 0.0;
+    cmdVelPub_.publish(cmd);
+  }
+}
+
+void TimedAgentNode::reportWaiting() {
+  if (running_ || exitStatus_ >= 0 || agent_->finished()) return;
+  if (secondsSince(lastReportAt_) < kReportEvery) return;
+  ROS_INFO("%s: at step %ld, waiting for the monitor %s to start the run", name_.c_str(), agent_->step(),
+           monitor_.c_str());
+  lastReportAt_ = ros::WallTime::now();
+}
+
+void TimedAgentNode::recover() {
+  std::vector<std::string> holders;
+  for (int j : agent_->neighbourIds()) holders.push_back(agentNodeName(nh_, j));
+  holders.push_back(monitor_);
+  std::vector<std::string> services;
+  for (const std::string& holder : holders) services.push_back(holder + "/recall");
+  std::vector<RecallState> calls(holders.size());
+  for (RecallState& call : calls) call.request.id = static_cast<uint32_t>(agent_->id());
+  const std::vector<bool> answered = callAllWithTimeout(services, calls, 2.0);
+  long best = 0;
+  std::size_t from = 0;
+  for (std::size_t k = 0; k < holders.size(); ++k) {
+    if (answered[k] && calls[k].response.held && calls[k].response.step > best) {
+      best = calls[k].response.step;
+      from = k;
+    }
+  }
+  if (best <= 0) {
+    ROS_INFO("%s: nobody holds a state of mine beyond step 0: starting from the scenario", name_.c_str());
+    return;
+  }
+  try {
+    agent_->restore(best, calls[from].response.position);
+    ROS_INFO("%s: recovered step %ld from %s; restarting from rest there", name_.c_str(), best,
+             holders[from].c_str());
+  } catch (const std::exception& e) {
+    ROS_WARN("%s: cannot restore from %s (%s): starting from the scenario", name_.c_str(), holders[from].c_str(),
+             e.what());
+  }
+}
+
+bool TimedAgentNode::onRecall(RecallState::Request& request, RecallState::Response& response) {
+  const auto it = newest_.find(static_cast<int>(request.id));
+  response.held = it != newest_.end();
+  if (response.held) {
+    response.step = it->second.step;
+    response.position = it->second.position;
+    response.previous_position = it->second.previous_position;
+  }
+  return true;
+}
+
+int TimedAgentNode::run() {
+  recover();
+  publish();  // the first state (step 0, or the recovered one), latched
+  lastReportAt_ = ros::WallTime::now();
+  tickTimer_ = nh_.createWallTimer(ros::WallDuration(h_ / rate_), [this](const ros::WallTimerEvent&) { onTick(); });
+  watchTimer_ = nh_.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) { reportWaiting(); });
+  while (ros::ok()) ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.1));
+  ROS_INFO("%s: done at step %ld, %ld ticks held, %ld states dropped, %ld lost (injected), %ld outdated or refused",
+           name_.c_str(), agent_->step(), agent_->heldTicks(), dropped_, faults_->lost(), agent_->dropped());
+  return exitStatus_ < 0 ? 0 : exitStatus_;
+}
+
+}  // namespace vf
