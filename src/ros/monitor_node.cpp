@@ -84,6 +84,8 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   newest_.resize(static_cast<std::size_t>(n));
   for (auto& m : newest_) m.step = -1;
   recallServer_ = pnh.advertiseService("recall", &MonitorNode::onRecall, this);
+  historyServer_ = pnh.advertiseService("history", &MonitorNode::onHistory, this);
+  unrecordedStates_.resize(static_cast<std::size_t>(n));
   progress_.state = RunProgress::WAITING;
   progress_.completed_step = -1;
   progress_.allowed_step = 0;
@@ -116,6 +118,9 @@ void MonitorNode::onState(int agent, const ros::MessageEvent<AgentState const>& 
       const auto receipt = monitor_->add(agent, msg.step, msg.position, msg.previous_position, acceptUpTo_);
       if (receipt == FormationMonitor::Receipt::Accepted || receipt == FormationMonitor::Receipt::Duplicate) {
         if (msg.step > newest_[static_cast<std::size_t>(agent)].step) newest_[static_cast<std::size_t>(agent)] = msg;
+        if (recording_ && receipt == FormationMonitor::Receipt::Accepted) {
+          unrecordedStates_[static_cast<std::size_t>(agent)].push_back(msg);
+        }
         owner.seen = true;
         owner.goneSince = ros::WallTime();
         if (receipt == FormationMonitor::Receipt::Accepted) publishCompleted();
@@ -147,6 +152,9 @@ void MonitorNode::onRecorderProgress(const ros::MessageEvent<RunProgress const>&
   }
   recordedStep_ = std::max(recordedStep_, static_cast<long>(p.completed_step));
   while (!unrecorded_.empty() && unrecorded_.front().first.step <= recordedStep_) unrecorded_.pop_front();
+  for (auto& states : unrecordedStates_) {
+    while (!states.empty() && states.front().step <= recordedStep_) states.pop_front();
+  }
   recorderDone_ = p.state == RunProgress::FINISHED;
   updateProgress();
 }
@@ -219,8 +227,10 @@ void MonitorNode::updateProgress() {
   // Publish on every change of state, and otherwise every quarter window: agents never wait
   // for a step the window already allows.
   const long every = std::max<long>(1, window_ / 4);
+  // ... and whenever the agents may already wait at the allowed step (nothing more is coming).
+  const bool agentsMayWait = completed >= progress_.allowed_step;
   if (next.state != progress_.state || next.allowed_step >= progress_.allowed_step + every ||
-      (next.allowed_step > progress_.allowed_step && next.allowed_step == last)) {
+      (next.allowed_step > progress_.allowed_step && (next.allowed_step == last || agentsMayWait))) {
     next.header.stamp.fromSec(std::max(0L, base) * monitor_->scenario().timeStep);
     acceptUpTo_ = std::max(acceptUpTo_, static_cast<long>(next.allowed_step));
     const auto at = congruentSinceAt_.find(base);
@@ -233,6 +243,10 @@ void MonitorNode::updateProgress() {
 
 std::string MonitorNode::waitingFor() const {
   const long next = monitor_->nextStep();
+  if (recording_ && progress_.state != RunProgress::WAITING && recordedStep_ + window_ < next) {
+    return "the recorder " + recorder_.node + " (it holds steps up to " + std::to_string(recordedStep_) +
+           ", and the agents may not run further ahead of it)";
+  }
   const std::vector<int> missing = monitor_->missingAt(next);
   if (!missing.empty()) return "step " + std::to_string(next) + " of " + agentList(missing);
   if (recording_ && recordedStep_ < completedStep()) {
@@ -362,12 +376,23 @@ std::vector<RecallHistory::Response> MonitorNode::fetchHistories(const std::vect
 
 void MonitorNode::addHistory(int agent, const RecallHistory::Response& held) {
   for (const AgentState& s : held.states) {
-    if (monitor_->add(agent, s.step, s.position, s.previous_position, acceptUpTo_) ==
-            FormationMonitor::Receipt::Accepted &&
-        s.step > newest_[static_cast<std::size_t>(agent)].step) {
-      newest_[static_cast<std::size_t>(agent)] = s;
+    if (monitor_->add(agent, s.step, s.position, s.previous_position, acceptUpTo_) !=
+        FormationMonitor::Receipt::Accepted) {
+      continue;
     }
+    if (s.step > newest_[static_cast<std::size_t>(agent)].step) newest_[static_cast<std::size_t>(agent)] = s;
+    if (recording_) unrecordedStates_[static_cast<std::size_t>(agent)].push_back(s);
   }
+}
+
+bool MonitorNode::onHistory(RecallHistory::Request& request, RecallHistory::Response& response) {
+  if (request.id >= 0 && request.id < static_cast<int>(unrecordedStates_.size())) {
+    const auto& states = unrecordedStates_[static_cast<std::size_t>(request.id)];
+    response.states.assign(states.begin(), states.end());
+  }
+  response.progress = progress_;
+  response.has_progress = true;
+  return true;
 }
 
 void MonitorNode::recover() {

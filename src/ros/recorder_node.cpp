@@ -18,8 +18,10 @@ constexpr uint32_t kQueue = 100000;  // far more than the monitor's window lets 
 ros::Time bagTime(const ros::Time& stamp) { return std::max(stamp, ros::TIME_MIN); }
 }  // namespace
 
+bool RecorderNode::Steps::holds(long step) const { return step < next || ahead.count(step) > 0; }
+
 bool RecorderNode::Steps::add(long step) {
-  if (step < next || ahead.count(step)) return false;
+  if (holds(step)) return false;
   ahead.insert(step);
   while (!ahead.empty() && *ahead.begin() == next) {
     ahead.erase(ahead.begin());
@@ -159,12 +161,19 @@ void RecorderNode::catchUp() {
       services.push_back(owners_[i] + "/history");
     }
   }
-  std::vector<RecallHistory> calls(services.size());
-  const std::vector<bool> answered = callAllWithTimeout(services, calls, 2.0);
+  // Ask the agents, and the monitor, which keeps what it accepted until this recorder confirms
+  // it (an agent that died again no longer holds its states).
+  std::vector<RecallHistory> calls(2 * agents.size());
   for (std::size_t k = 0; k < agents.size(); ++k) {
-    if (!answered[k]) continue;
-    for (const AgentState& s : calls[k].response.states) {
-      if (s.step >= states_[static_cast<std::size_t>(agents[k])].next) record(agents[k], s);
+    services.push_back(monitor_ + "/history");
+    calls[agents.size() + k].request.id = agents[k];
+  }
+  const std::vector<bool> answered = callAllWithTimeout(services, calls, 2.0);
+  for (std::size_t c = 0; c < calls.size(); ++c) {
+    if (!answered[c]) continue;
+    const int agent = agents[c % agents.size()];
+    for (const AgentState& s : calls[c].response.states) {
+      if (!states_[static_cast<std::size_t>(agent)].holds(s.step)) record(agent, s);
     }
   }
   stalledSince_ = ros::WallTime::now();

@@ -65,6 +65,7 @@ class MonitorNode {
   std::vector<RecallHistory::Response> fetchHistories(const std::vector<int>& agents);
   void addHistory(int agent, const RecallHistory::Response& held);
   bool onRecall(RecallState::Request& request, RecallState::Response& response);
+  bool onHistory(RecallHistory::Request& request, RecallHistory::Response& response);
   void onState(int agent, const ros::MessageEvent<AgentState const>& event);
   void onRecorderProgress(const ros::MessageEvent<RunProgress const>& event);
   void publishCompleted();
@@ -86,7 +87,10 @@ class MonitorNode {
   ros::Subscriber recorderSub_;
   ros::Publisher statusPub_, markersPub_, progressPub_;
   ros::WallTimer watchTimer_;
-  ros::ServiceServer recallServer_;
+  ros::ServiceServer recallServer_, historyServer_;
+  /// Accepted states the recorder has not confirmed, per agent (at most a window each): an agent
+  /// that dies again before the recorder got them no longer holds them.
+  std::vector<std::deque<AgentState>> unrecordedStates_;
   std::vector<AgentState> newest_;          // each agent's newest state, for ~recall
   std::map<long, long> congruentSinceAt_;   // completed step -> first step of its congruent stretch
   std::vector<Participant> agents_;

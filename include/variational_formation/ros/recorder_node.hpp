@@ -52,6 +52,7 @@ class RecorderNode {
     std::set<long> ahead;
     /// @return true if the step is new.
     bool add(long step);
+    bool holds(long step) const;
   };
   template <typename M>
   void write(const std::string& topic, const M& msg, const ros::Time& stamp);
