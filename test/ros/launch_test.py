@@ -169,7 +169,10 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
                   for i in range(self.scenario["n"])]
         logs = []
         try:
-            time.sleep(6.5)  # the agents are up and wait for the monitor, saying so
+            # Until every agent is up (its latched step 0) and has waited long enough to say so.
+            for i in range(self.scenario["n"]):
+                rospy.wait_for_message(f"/formation/agent_{i}/state", AgentState, timeout=60)
+            time.sleep(6.0)
             run = run_formation(f"scenario:={SCENARIO}", "agents:=false", "record:=true", f"output_dir:={out}")
             self.assertEqual(run.returncode, 0, run.stdout[-3000:] + run.stderr[-2000:])
             for a in agents:  # the run is over: the agents idle until they are stopped, as on robots
