@@ -20,6 +20,7 @@ VF_APT_PACKAGES=(
   rosbash rviz libeigen3-dev libyaml-cpp-dev libgtest-dev googletest libbenchmark-dev
   python3-matplotlib python3-numpy python3-yaml xvfb x11-apps python3-tf2-ros
   python3-rosparam python3-rospkg ros-nav-msgs libnav-msgs-dev python3-nav-msgs python3-setuptools
+  libnodeletlib-dev libnodeletlib-tools libnodelet-dev pluginlib-dev
 )
 
 vf_install_dependencies() {

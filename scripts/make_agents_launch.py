@@ -8,7 +8,8 @@ here. Prints the path it wrote (the parameter's value). On bad input: one line o
 exit status 2.
 
 usage: make_agents_launch.py --scenario FILE --out FILE [--rate R] [--order forward|reverse]
-                             [--stagger SECONDS] [--respawn true|false]
+                             [--stagger SECONDS] [--respawn true|false] [--manager NAME]
+--manager loads every agent as a nodelet into that manager (agent.launch manager:=NAME).
 """
 import argparse
 import math
@@ -62,6 +63,7 @@ def main():
     parser.add_argument("--order", choices=("forward", "reverse"), default="forward")
     parser.add_argument("--stagger", type=non_negative("stagger"), default="0")
     parser.add_argument("--respawn", type=boolean("respawn"), default="true")
+    parser.add_argument("--manager", default="")
     parser.error = lambda message: fail(message.replace("argument --", ""))
     args = parser.parse_args()
     count = agent_count(args.scenario, args.rate)
@@ -75,7 +77,8 @@ def main():
         prefix = f"bash -c 'sleep {delay:g}; exec \"$0\" \"$@\"'" if delay > 0 else ""
         lines.append('  <include file="$(find variational_formation)/launch/agent.launch">')
         for name, value in (("id", str(i)), ("scenario", args.scenario), ("rate", args.rate),
-                            ("respawn", args.respawn), ("launch_prefix", prefix)):
+                            ("respawn", args.respawn), ("launch_prefix", prefix)) + \
+                ((("manager", args.manager),) if args.manager else ()):
             lines.append(f"    <arg name={quoteattr(name)} value={quoteattr(value)}/>")
         lines.append("  </include>")
     lines.append("</launch>")

@@ -139,7 +139,8 @@ Eigen::MatrixXd Formation::rigidityMatrix(const Positions& q) const {
 
 int Formation::rigidityRank(const Positions& q) const {
   if (edges_.empty()) return 0;
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(rigidityMatrix(q));
+  // Divide and conquer: the same rank, in a fraction of Jacobi's time for hundreds of agents.
+  Eigen::BDCSVD<Eigen::MatrixXd> svd(rigidityMatrix(q));
   const Eigen::VectorXd s = svd.singularValues();
   const double tol = 1e-9 * std::max(1.0, s(0));
   return static_cast<int>((s.array() > tol).count());
@@ -181,8 +182,12 @@ double Formation::maxDistanceError(const Positions& q) const {
 bool Formation::isCongruent(const Positions& q, const Velocities& v, double tolerance,
                             double maxSpeed) const {
   const int n = agentCount();
+  // Speeds first, O(n): the O(n^2) pair test runs only once every agent is slow (the monitor
+  // calls this every step).
   for (int i = 0; i < n; ++i) {
     if (!(v.col(i).norm() < maxSpeed)) return false;
+  }
+  for (int i = 0; i < n; ++i) {
     for (int j = i + 1; j < n; ++j) {
       const double desired = (desiredShape_.col(i) - desiredShape_.col(j)).norm();
       const double actual = (q.col(i) - q.col(j)).norm();

@@ -30,6 +30,7 @@ RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) 
   const Scenario scenario = loadScenario(requiredParam<std::string>(pnh, "scenario"));
   path_ = requiredParam<std::string>(pnh, "bag");
   monitor_ = participantName(nh, optionalParam<std::string>(pnh, "monitor", "monitor"));
+  managers_ = agentManagers(nh, pnh);
   steps_ = scenario.steps;
   timeStep_ = scenario.timeStep;
   const int n = scenario.agentCount();
@@ -130,7 +131,7 @@ void RecorderNode::write(const std::string& topic, const M& msg, const ros::Time
 
 void RecorderNode::onState(int agent, const ros::MessageEvent<AgentState const>& event) {
   const AgentState& msg = *event.getConstMessage();
-  if (!fromOwner(event, owners_[static_cast<std::size_t>(agent)]) || static_cast<int>(msg.id) != agent) {
+  if (!fromAgent(event, owners_[static_cast<std::size_t>(agent)], managers_) || static_cast<int>(msg.id) != agent) {
     ++dropped_;
     ROS_WARN_THROTTLE(1.0, "recorder: dropped a state on agent_%d's topic from %s; %ld dropped so far", agent,
                       event.getPublisherName().c_str(), dropped_);

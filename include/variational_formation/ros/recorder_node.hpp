@@ -75,6 +75,7 @@ class RecorderNode {
   long steps_ = 0;
   double timeStep_ = 0.0;
   std::vector<std::string> owners_;
+  std::vector<std::string> managers_;  // ~agent_manager: nodelet managers of agents
   std::vector<Steps> states_;
   Steps status_;
   long markers_ = 0, written_ = 0, repeats_ = 0, dropped_ = 0;
