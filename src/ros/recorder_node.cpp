@@ -1,5 +1,8 @@
 #include "variational_formation/ros/recorder_node.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include <ros/callback_queue.h>
 #include <tf2_msgs/TFMessage.h>
 
@@ -200,6 +203,9 @@ void RecorderNode::onMarkers(const ros::MessageEvent<visualization_msgs::MarkerA
   const auto& msg = *event.getConstMessage();
   write(nh_.resolveName("markers"), msg, msg.markers.empty() ? ros::TIME_MIN : msg.markers[0].header.stamp);
   ++markers_;
+  if (!msg.markers.empty()) {
+    markerStep_ = std::max(markerStep_, std::lround(msg.markers[0].header.stamp.toSec() / timeStep_));
+  }
   report();
 }
 
@@ -218,6 +224,9 @@ void RecorderNode::report() {
   long complete = status_.next - 1;
   for (const Steps& s : states_) complete = std::min(complete, s.next - 1);
   if (markers_ == 0) complete = -1;
+  // The monitor always publishes the last step's markers; markers are larger than states and
+  // status and may trail them (a fast run), so the bag stays open until they are in.
+  if (steps_ > 0 && complete >= steps_ && markerStep_ < steps_) complete = steps_ - 1;
   if (complete <= progress_.completed_step) return;
   progress_.completed_step = complete;
   progress_.header.stamp.fromSec(static_cast<double>(complete) * timeStep_);

@@ -79,6 +79,7 @@ class RecorderNode {
   std::vector<Steps> states_;
   Steps status_;
   long markers_ = 0, written_ = 0, repeats_ = 0, dropped_ = 0;
+  long markerStep_ = -1;  // the newest step whose markers came
   bool open_ = false;
   ros::WallTimer catchUpTimer_;
   ros::WallTime stalledSince_;
