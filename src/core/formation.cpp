@@ -139,8 +139,7 @@ Eigen::MatrixXd Formation::rigidityMatrix(const Positions& q) const {
 
 int Formation::rigidityRank(const Positions& q) const {
   if (edges_.empty()) return 0;
-  // Divide and conquer: the same rank, in a fraction of Jacobi's time for hundreds of agents.
-  Eigen::BDCSVD<Eigen::MatrixXd> svd(rigidityMatrix(q));
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(rigidityMatrix(q));
   const Eigen::VectorXd s = svd.singularValues();
   const double tol = 1e-9 * std::max(1.0, s(0));
   return static_cast<int>((s.array() > tol).count());
