@@ -16,7 +16,11 @@ foreach(node agent monitor recorder)
   target_compile_options(${node} PRIVATE ${VF_FLAGS})
   install(TARGETS ${node} RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 endforeach()
-install(TARGETS variational_formation_ros
+# The agent as a nodelet plugin (nodelet_plugins.xml), over the same AgentNode.
+add_library(variational_formation_nodelets src/ros/agent_nodelet.cpp)
+target_link_libraries(variational_formation_nodelets variational_formation_ros)
+target_compile_options(variational_formation_nodelets PRIVATE ${VF_FLAGS})
+install(TARGETS variational_formation_ros variational_formation_nodelets
   ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
 
@@ -31,7 +35,9 @@ if(CATKIN_ENABLE_TESTING)
     "scenario:=grid24"
     "scenario:=free_particle expect:=free_particle"
     "scenario:=hexagon order:=reverse stagger:=1"
-    "scenario:=hexagon rate:=1 inject:=true")
+    "scenario:=hexagon rate:=1 inject:=true"
+    "scenario:=hexagon nodelet:=true"
+    "scenario:=grid24 nodelet:=true")
   foreach(case ${VF_RUN_CASES})
     separate_arguments(args UNIX_COMMAND "${case}")
     add_rostest(test/ros/distributed_run.test ARGS ${args})
@@ -53,6 +59,8 @@ if(CATKIN_ENABLE_TESTING)
   endforeach()
   add_rostest(test/ros/timed_bad_input.test)
   add_rostest(test/ros/robots_run.test)
+  # SIGKILL to the nodelet manager of every agent during a recorded run: test/ros/nodelet_fault.test.
+  add_rostest(test/ros/nodelet_fault.test ARGS seed:=3)
   foreach(t two_formations launch)
     add_rostest(test/ros/${t}.test)
   endforeach()

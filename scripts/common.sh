@@ -23,6 +23,7 @@ VF_APT_PACKAGES=(
   python3-rosunit iproute2
   libdiagnostic-updater-dev python3-dynamic-reconfigure libdynamic-reconfigure-config-init-mutex-dev
   python3-diagnostic-msgs
+  libnodeletlib-dev libnodeletlib-tools libnodelet-dev pluginlib-dev
 )
 
 vf_install_dependencies() {

@@ -8,11 +8,12 @@ here. Prints the path it wrote (the parameter's value). On bad input: one line o
 exit status 2.
 
 usage: make_agents_launch.py --scenario FILE --out FILE [--rate R] [--order forward|reverse]
-                             [--stagger SECONDS] [--respawn true|false]
+                             [--stagger SECONDS] [--respawn true|false] [--manager NAME]
                              [--mode lockstep|timed [--delay S] [--jitter S] [--loss P] [--max-age S]
                               [--seed N] [--respawn-delay S] [--robot true|false [--lag S] [--noise M]]]
 With --robot true (timed mode), each agent also gets a simulated robot, robot_sim, in
 formation/robot_<id> (odom and cmd_vel there), started at the scenario's initial position.
+--manager loads every agent as a nodelet into that manager (agent.launch manager:=NAME).
 """
 import argparse
 import math
@@ -128,6 +129,7 @@ def main():
     parser.add_argument("--respawn-delay", type=non_negative("respawn_delay"), default="0")
     parser.add_argument("--lag", type=non_negative("lag"), default="0.1")
     parser.add_argument("--noise", type=non_negative("noise"), default="0.01")
+    parser.add_argument("--manager", default="")
     parser.error = lambda message: fail(message.replace("argument --", ""))
     args = parser.parse_args()
     if args.robot == "true" and args.mode != "timed":
@@ -145,7 +147,8 @@ def main():
         prefix = f"bash -c 'sleep {delay:g}; exec \"$0\" \"$@\"'" if delay > 0 else ""
         lines.append('  <include file="$(find variational_formation)/launch/agent.launch">')
         for name, value in (("id", str(i)), ("scenario", args.scenario), ("rate", args.rate),
-                            ("respawn", args.respawn), ("launch_prefix", prefix)) + timed_args(args, i):
+                            ("respawn", args.respawn), ("launch_prefix", prefix)) + timed_args(args, i) + \
+                ((("manager", args.manager),) if args.manager else ()):
             lines.append(f"    <arg name={quoteattr(name)} value={quoteattr(value)}/>")
         lines.append("  </include>")
         if args.robot == "true":

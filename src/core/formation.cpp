@@ -181,8 +181,12 @@ double Formation::maxDistanceError(const Positions& q) const {
 bool Formation::isCongruent(const Positions& q, const Velocities& v, double tolerance,
                             double maxSpeed) const {
   const int n = agentCount();
+  // Speeds first, O(n): the O(n^2) pair test runs only once every agent is slow (the monitor
+  // calls this every step).
   for (int i = 0; i < n; ++i) {
     if (!(v.col(i).norm() < maxSpeed)) return false;
+  }
+  for (int i = 0; i < n; ++i) {
     for (int j = i + 1; j < n; ++j) {
       const double desired = (desiredShape_.col(i) - desiredShape_.col(j)).norm();
       const double actual = (q.col(i) - q.col(j)).norm();

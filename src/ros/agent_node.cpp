@@ -26,20 +26,11 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   // Frames carry the namespace, so that two formations side by side have distinct frames.
   const std::string ns = nh.getNamespace() == "/" ? "" : nh.getNamespace().substr(1) + "/";
   frame_ = ns + name_;
+  managers_ = agentManagers(nh, pnh);
   statePub_ = nh.advertise<AgentState>(name_ + "/state", 1000, /*latch=*/true);
-  for (int j : agent_->neighbourIds()) {
-    neighbourOwners_.push_back(agentNodeName(nh, j));
-    subs_.push_back(nh.subscribe<AgentState>(
-        "agent_" + std::to_string(j) + "/state", 1000,
-        boost::function<void(const ros::MessageEvent<AgentState const>&)>(
-            [this, j](const ros::MessageEvent<AgentState const>& e) { onNeighbourState(j, e); }),
-        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
-  }
-  progressSub_ = nh.subscribe<RunProgress>(
-      "progress", 10,
-      boost::function<void(const ros::MessageEvent<RunProgress const>&)>(
-          [this](const ros::MessageEvent<RunProgress const>& e) { onProgress(e); }),
-      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  for (int j : agent_->neighbourIds()) neighbourOwners_.push_back(agentNodeName(nh, j));
+  // Served from the start, so that restarting neighbours can ask; the subscriptions wait for
+  // start(), which resumes the agent before any state reaches it.
   recallServer_ = nh.advertiseService(name_ + "/recall", &AgentNode::onRecall, this);
   historyServer_ = nh.advertiseService(name_ + "/history", &AgentNode::onHistory, this);
   for (const std::string& w : scenario.warnings) ROS_WARN("%s: %s", name_.c_str(), w.c_str());
@@ -59,7 +50,7 @@ void AgentNode::onNeighbourState(int neighbour, const ros::MessageEvent<AgentSta
     const AgentState& msg = *event.getConstMessage();
     std::size_t k = 0;
     while (agent_->neighbourIds()[k] != neighbour) ++k;
-    if (!fromOwner(event, neighbourOwners_[k])) {
+    if (!fromAgent(event, neighbourOwners_[k], managers_)) {
       drop("a state on agent_" + std::to_string(neighbour) + "'s topic from " + event.getPublisherName() +
            ", which does not own it");
       return;
@@ -86,7 +77,7 @@ void AgentNode::onProgress(const ros::MessageEvent<RunProgress const>& event) {
   if (!hasProgress_ || p.completed_step >= lastProgress_.completed_step) {
     lastProgress_ = p;
     hasProgress_ = true;
-    while (!history_.empty() && history_.front().step <= p.completed_step) history_.pop_front();
+    while (!history_.empty() && history_.front()->step <= p.completed_step) history_.pop_front();
   }
   if (p.state == RunProgress::FINISHED || p.state == RunProgress::FAILED) {
     // Stay up, idle: a respawning agent that exited would only be restarted.
@@ -135,7 +126,10 @@ void AgentNode::tryAdvance() {
 }
 
 void AgentNode::publish() {
-  AgentState msg;
+  // Built once and published as a pointer to const: subscribers in the same process (nodelets in
+  // one manager) receive this very object, without a copy or serialisation.
+  const AgentStatePtr state = boost::make_shared<AgentState>();
+  AgentState& msg = *state;
   msg.header.stamp.fromSec(agent_->time());
   msg.header.frame_id = "world";
   msg.id = static_cast<uint32_t>(agent_->id());
@@ -145,8 +139,9 @@ void AgentNode::publish() {
   msg.previous_position = agent_->previousPosition();
   msg.dropped = static_cast<uint32_t>(dropped_);
   msg.failure = failure_;
-  statePub_.publish(msg);
-  history_.push_back(msg);
+  const AgentState::ConstPtr published = state;
+  statePub_.publish(published);
+  history_.push_back(published);
 
   geometry_msgs::TransformStamped t;
   t.header = msg.header;
@@ -181,10 +176,8 @@ void AgentNode::reportWaiting() {
   lastReportAt_ = ros::WallTime::now();
 }
 
-void AgentNode::recover() {
-  long best = -1;
-  RecallState::Response found;
-  std::string from;
+AgentNode::Recovery AgentNode::askHolders() const {
+  Recovery r;
   std::vector<std::string> holders;
   for (int j : agent_->neighbourIds()) holders.push_back(agentNodeName(nh_, j));
   holders.push_back(monitor_);  // the fallback: it holds everyone's newest state
@@ -195,12 +188,19 @@ void AgentNode::recover() {
   const std::vector<bool> answered = callAllWithTimeout(services, calls, 2.0);
   for (std::size_t k = 0; k < holders.size(); ++k) {
     if (!answered[k] || !calls[k].response.held) continue;
-    if (calls[k].response.step > best) {
-      best = calls[k].response.step;
-      found = calls[k].response;
-      from = holders[k];
+    if (calls[k].response.step > r.step) {
+      r.step = calls[k].response.step;
+      r.found = calls[k].response;
+      r.from = holders[k];
     }
   }
+  return r;
+}
+
+void AgentNode::resume(const Recovery& r) {
+  const long best = r.step;
+  const RecallState::Response& found = r.found;
+  const std::string& from = r.from;
   if (best <= 0) {
     ROS_INFO("%s: nobody holds a state of mine beyond step 0: starting from the scenario", name_.c_str());
     return;
@@ -222,17 +222,33 @@ bool AgentNode::onRecall(RecallState::Request& request, RecallState::Response& r
 }
 
 bool AgentNode::onHistory(RecallHistory::Request&, RecallHistory::Response& response) {
-  response.states.assign(history_.begin(), history_.end());
+  for (const AgentState::ConstPtr& state : history_) response.states.push_back(*state);
   response.progress = lastProgress_;
   response.has_progress = hasProgress_;
   return true;
 }
 
-int AgentNode::run() {
-  recover();
+void AgentNode::start(const Recovery& recovery) {
+  resume(recovery);
+  for (int j : agent_->neighbourIds()) {
+    subs_.push_back(nh_.subscribe<AgentState>(
+        "agent_" + std::to_string(j) + "/state", 1000,
+        boost::function<void(const ros::MessageEvent<AgentState const>&)>(
+            [this, j](const ros::MessageEvent<AgentState const>& e) { onNeighbourState(j, e); }),
+        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
+  }
+  progressSub_ = nh_.subscribe<RunProgress>(
+      "progress", 10,
+      boost::function<void(const ros::MessageEvent<RunProgress const>&)>(
+          [this](const ros::MessageEvent<RunProgress const>& e) { onProgress(e); }),
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
   publish();  // the first state (step 0, or the recovered one), latched
   lastReportAt_ = ros::WallTime::now();
   watchTimer_ = nh_.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) { reportWaiting(); });
+}
+
+int AgentNode::run() {
+  start(askHolders());
   while (ros::ok()) ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.1));
   ROS_INFO("%s: done at step %ld, %ld states dropped", name_.c_str(), agent_->step(), dropped_);
   return exitStatus_ < 0 ? 0 : exitStatus_;

@@ -34,10 +34,13 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   const std::string path = requiredParam<std::string>(pnh, "scenario");
   trailLength_ = optionalParam(pnh, "trail_length", 100);
   window_ = optionalParam(pnh, "window", 100);
+  markerEvery_ = optionalParam(pnh, "marker_every", 1);
+  if (markerEvery_ < 1) throw InvalidInput("~marker_every: must be >= 1, got " + std::to_string(markerEvery_));
   const std::string recorder = optionalParam<std::string>(pnh, "recorder", "");
   resultFile_ = optionalParam<std::string>(pnh, "result_file", "");
   waitForViewer_ = optionalParam(pnh, "wait_for_viewer", false);
   respawnTimeout_ = optionalParam(pnh, "respawn_timeout", 0.0);
+  managers_ = agentManagers(nh, pnh);
   if (trailLength_ < 2) throw InvalidInput("~trail_length: must be >= 2");
   if (window_ < 1) throw InvalidInput("~window: must be >= 1, got " + std::to_string(window_));
   if (!(respawnTimeout_ >= 0.0)) throw InvalidInput("~respawn_timeout: must be >= 0");
@@ -100,7 +103,7 @@ void MonitorNode::onState(int agent, const ros::MessageEvent<AgentState const>& 
   const AgentState& msg = *event.getConstMessage();
   Participant& owner = agents_[static_cast<std::size_t>(agent)];
   std::string why;
-  if (!fromOwner(event, owner.node)) {
+  if (!fromAgent(event, owner.node, managers_)) {
     why = "from " + event.getPublisherName() + ", which does not own it";
   } else if (static_cast<int>(msg.id) != agent) {
     why = "with id " + std::to_string(msg.id);
@@ -185,9 +188,17 @@ void MonitorNode::publishCompleted() {
       status.angular_momentum_predicted.z = nan;
     }
     statusPub_.publish(status);
-    visualization_msgs::MarkerArray markers = makeMarkers(s, monitor_->formation(), trails_);
-    for (auto& m : markers.markers) m.header.stamp = stamp;
-    markersPub_.publish(markers);
+    // Markers cost O(n x trail length) per step: built only when someone takes them (the
+    // recorder, a viewer), every marker_every steps, and always at the first and last step so
+    // that the latched one is right. The trails above still get every step.
+    const long last = monitor_->scenario().steps;
+    const bool edge = s.metrics.step == 0 || (last > 0 && s.metrics.step == last);
+    visualization_msgs::MarkerArray markers;
+    if (edge || (s.metrics.step % markerEvery_ == 0 && (recording_ || markersPub_.getNumSubscribers() > 0))) {
+      markers = makeMarkers(s, monitor_->formation(), trails_);
+      for (auto& m : markers.markers) m.header.stamp = stamp;
+      markersPub_.publish(markers);
+    }
     if (recording_) unrecorded_.push_back({status, markers});
     convergedStep_ = s.converged ? s.convergedStep : -1;
     congruentSinceAt_[s.metrics.step] = convergedStep_;
@@ -301,7 +312,7 @@ void MonitorNode::watch() {
     if (recording_ && recordedStep_ < completedStep()) {
       for (const auto& sm : unrecorded_) {
         statusPub_.publish(sm.first);
-        markersPub_.publish(sm.second);
+        if (!sm.second.markers.empty()) markersPub_.publish(sm.second);
       }
     }
   }

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <sstream>
 
 #include <ros/master.h>
 
@@ -21,6 +22,15 @@ std::string agentNodeName(const ros::NodeHandle& nh, int id) {
 
 std::string participantName(const ros::NodeHandle& nh, const std::string& relative) {
   return nh.resolveName(relative, /*remap=*/false);
+}
+
+std::vector<std::string> agentManagers(const ros::NodeHandle& nh, const ros::NodeHandle& pnh) {
+  std::string list;
+  pnh.param<std::string>("agent_manager", list, "");
+  std::istringstream words(list);
+  std::vector<std::string> managers;
+  for (std::string w; words >> w;) managers.push_back(participantName(nh, w));
+  return managers;
 }
 
 namespace {

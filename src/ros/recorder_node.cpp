@@ -1,5 +1,6 @@
 #include "variational_formation/ros/recorder_node.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <ros/callback_queue.h>
@@ -34,6 +35,9 @@ RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) 
   const Scenario scenario = loadScenario(requiredParam<std::string>(pnh, "scenario"));
   path_ = requiredParam<std::string>(pnh, "bag");
   monitor_ = participantName(nh, optionalParam<std::string>(pnh, "monitor", "monitor"));
+  managers_ = agentManagers(nh, pnh);
+  markerEvery_ = optionalParam(pnh, "marker_every", 1);
+  if (markerEvery_ < 1) throw InvalidInput("~marker_every: must be >= 1, got " + std::to_string(markerEvery_));
   steps_ = scenario.steps;
   timeStep_ = scenario.timeStep;
   const int n = scenario.agentCount();
@@ -134,7 +138,7 @@ void RecorderNode::write(const std::string& topic, const M& msg, const ros::Time
 
 void RecorderNode::onState(int agent, const ros::MessageEvent<AgentState const>& event) {
   const AgentState& msg = *event.getConstMessage();
-  if (!fromOwner(event, owners_[static_cast<std::size_t>(agent)]) || static_cast<int>(msg.id) != agent) {
+  if (!fromAgent(event, owners_[static_cast<std::size_t>(agent)], managers_) || static_cast<int>(msg.id) != agent) {
     ++dropped_;
     ROS_WARN_THROTTLE(1.0, "recorder: dropped a state on agent_%d's topic from %s; %ld dropped so far", agent,
                       event.getPublisherName().c_str(), dropped_);
@@ -210,7 +214,21 @@ void RecorderNode::onMarkers(const ros::MessageEvent<visualization_msgs::MarkerA
   const auto& msg = *event.getConstMessage();
   const ros::Time stamp = msg.markers.empty() ? ros::TIME_MIN : msg.markers[0].header.stamp;
   write(nh_.resolveName("markers"), msg, stamp);
-  if (markers_.add(std::lround(stamp.toSec() / timeStep_))) report();
+  const long step = std::lround(stamp.toSec() / timeStep_);
+  bool added = false;
+  if (step % markerEvery_ == 0) {
+    added = markers_.add(step / markerEvery_);
+  } else if (steps_ > 0 && step == steps_ && !lastMarker_) {
+    added = lastMarker_ = true;
+  }
+  if (added) report();
+}
+
+// The monitor publishes the markers of every marker_every-th step and of the last one.
+long RecorderNode::markersThrough() const {
+  const long through = markers_.next * markerEvery_ - 1;
+  if (steps_ <= 0 || through < steps_ || steps_ % markerEvery_ == 0 || lastMarker_) return through;
+  return steps_ - 1;
 }
 
 void RecorderNode::onMonitorProgress(const ros::MessageEvent<RunProgress const>& event) {
@@ -225,7 +243,7 @@ void RecorderNode::onMonitorProgress(const ros::MessageEvent<RunProgress const>&
 void RecorderNode::report() {
   if (progress_.state == RunProgress::FAILED || progress_.state == RunProgress::FINISHED) return;
   // Complete up to k: every agent's states, the status and the markers up to k.
-  long complete = std::min(status_.next, markers_.next) - 1;
+  long complete = std::min(status_.next - 1, markersThrough());
   for (const Steps& s : states_) complete = std::min(complete, s.next - 1);
   if (complete <= progress_.completed_step) return;
   progress_.completed_step = complete;

@@ -18,6 +18,7 @@
 namespace vf {
 
 using variational_formation::AgentState;
+using variational_formation::AgentStatePtr;
 using variational_formation::RecallHistory;
 using variational_formation::RecallState;
 using variational_formation::RunProgress;
@@ -38,13 +39,31 @@ using variational_formation::RunProgress;
  * then 0 if the run finished, 1 if it failed.
  *
  * Private parameters: ~id, ~scenario (required), ~real_time_factor (0 = as fast as possible),
- * ~monitor (name of the monitor node, relative to the namespace; default "monitor").
+ * ~monitor (name of the monitor node, relative to the namespace; default "monitor"), ~agent_manager
+ * (nodelet managers whose caller id a neighbour's state may carry; default none).
  */
 class AgentNode {
  public:
+  /// What the holders (neighbours, then the monitor) answered about this agent's newest state.
+  struct Recovery {
+    long step = -1;  // the highest step held, -1 if none
+    RecallState::Response found;
+    std::string from;
+  };
+
+  /// Reads and checks the parameters and the scenario, advertises the state topic and the
+  /// recall and history services (answered on nh's callback queue). Callbacks run on nh's
+  /// queue (the global one for a node, the nodelet's own one in a manager), one at a time.
   /// @throws InvalidInput on a missing or bad parameter or scenario.
   AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
-  /// Spins until shutdown. @return 0, or 1 if the monitor said the run failed.
+  /// The recall calls of crash recovery: blocks up to 2 s, touches nothing that callbacks change,
+  /// so it may run on any thread.
+  Recovery askHolders() const;
+  /// Resumes from `recovery`, subscribes, publishes the first state and starts the timers. Call
+  /// on nh's queue (or before it is served).
+  void start(const Recovery& recovery);
+  /// The node's main: start(askHolders()), then spins the global queue until shutdown.
+  /// @return 0, or 1 if the monitor said the run failed.
   int run();
 
  private:
@@ -55,7 +74,7 @@ class AgentNode {
   void reportWaiting();
   std::string waitingFor() const;
   void drop(const std::string& why);
-  void recover();
+  void resume(const Recovery& recovery);
   bool onRecall(RecallState::Request& request, RecallState::Response& response);
   bool onHistory(RecallHistory::Request& request, RecallHistory::Response& response);
 
@@ -64,9 +83,10 @@ class AgentNode {
   ros::Publisher statePub_;
   std::vector<ros::Subscriber> subs_;
   std::vector<std::string> neighbourOwners_;  // full node names, indexed like neighbourIds()
+  std::vector<std::string> managers_;         // ~agent_manager: nodelet managers of agents
   ros::Subscriber progressSub_;
   ros::ServiceServer recallServer_, historyServer_;
-  std::deque<AgentState> history_;  // published states after the last completed step
+  std::deque<AgentState::ConstPtr> history_;  // published states after the last completed step
   RunProgress lastProgress_;
   bool hasProgress_ = false;
   long startStep_ = 0;

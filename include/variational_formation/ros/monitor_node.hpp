@@ -35,7 +35,10 @@ using variational_formation::RunProgress;
  * Private parameters: ~scenario (required), ~trail_length (100), ~window (100), ~recorder (name
  * of the recorder node, "" = no recording), ~result_file ("" = none), ~wait_for_viewer (false:
  * with true, the start also waits for a subscriber of `markers`, i.e. rviz), ~respawn_timeout
- * (seconds a dead agent may take to come back before the run fails; 0 = fail at once).
+ * (seconds a dead agent may take to come back before the run fails; 0 = fail at once),
+ * ~marker_every (1: markers of every k-th step, and of the first and last; none are built while
+ * nobody subscribes and nothing is recorded), ~agent_manager (nodelet managers whose caller id an
+ * agent's state may carry; "" = none).
  *
  * Timed mode (~mode timed, ~real_time_factor > 0; doc/robots.md): the agents do not wait for each
  * other, so there are no completed steps to wait for. Once every agent's first state is there it
@@ -94,12 +97,14 @@ class MonitorNode {
   std::vector<AgentState> newest_;          // each agent's newest state, for ~recall
   std::map<long, long> congruentSinceAt_;   // completed step -> first step of its congruent stretch
   std::vector<Participant> agents_;
+  std::vector<std::string> managers_;  // ~agent_manager: nodelet managers of agents
   Participant recorder_;
   bool recording_ = false;
   long recordedStep_ = -1;
   bool recorderDone_ = false;
   std::vector<std::deque<Eigen::Vector3d>> trails_;
   int trailLength_ = 100;
+  long markerEvery_ = 1;  // ~marker_every: markers of every k-th step (and the first and last)
   long window_ = 100;
   bool waitForViewer_ = false;
   double respawnTimeout_ = 0.0;

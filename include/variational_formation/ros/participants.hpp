@@ -1,6 +1,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <ros/ros.h>
 
@@ -18,6 +19,24 @@ std::string participantName(const ros::NodeHandle& nh, const std::string& relati
 template <class Event>
 bool fromOwner(const Event& event, const std::string& owner) {
   return event.getPublisherName() == owner;
+}
+
+/**
+ * The nodelet managers that agents of this formation may be loaded in (doc/distributed.md,
+ * "Nodelets"): the private parameter `~agent_manager`, names relative to the namespace of `nh`,
+ * separated by spaces; empty when every agent is a node of its own.
+ */
+std::vector<std::string> agentManagers(const ros::NodeHandle& nh, const ros::NodeHandle& pnh);
+
+/// fromOwner for an agent's state: a nodelet's messages carry its manager's name as caller id,
+/// so a state from one of `managers` is accepted too.
+template <class Event>
+bool fromAgent(const Event& event, const std::string& owner, const std::vector<std::string>& managers) {
+  if (fromOwner(event, owner)) return true;
+  for (const std::string& m : managers) {
+    if (event.getPublisherName() == m) return true;
+  }
+  return false;
 }
 
 /// What the master and the node's own XML-RPC port say about a node.

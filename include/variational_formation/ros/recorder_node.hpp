@@ -76,8 +76,13 @@ class RecorderNode {
   long steps_ = 0;
   double timeStep_ = 0.0;
   std::vector<std::string> owners_;
+  std::vector<std::string> managers_;  // ~agent_manager: nodelet managers of agents
   std::vector<Steps> states_;
-  Steps status_, markers_;  // markers by the step of their stamp t_k
+  Steps status_;
+  Steps markers_;  // markers by k / marker_every, for the steps t_k that are multiples of it
+  long markerEvery_ = 1;
+  bool lastMarker_ = false;  // the last step's markers, when it is not a multiple
+  long markersThrough() const;
   long written_ = 0, repeats_ = 0, dropped_ = 0;
   bool open_ = false;
   ros::WallTimer catchUpTimer_;
