@@ -10,7 +10,7 @@ target_link_libraries(variational_formation_ros variational_formation_core ${cat
 target_compile_options(variational_formation_ros PRIVATE ${VF_FLAGS})
 add_dependencies(variational_formation_ros ${PROJECT_NAME}_generate_messages_cpp ${catkin_EXPORTED_TARGETS})
 
-foreach(node agent monitor recorder)
+foreach(node agent monitor recorder agent_manager)
   add_executable(${node} src/ros/${node}_main.cpp)
   target_link_libraries(${node} variational_formation_ros)
   target_compile_options(${node} PRIVATE ${VF_FLAGS})

@@ -1,21 +1,21 @@
 #!/usr/bin/env bash
 # Throughput and cost of the distributed lockstep run, as one table: agent count x mode.
 #   process: one process per agent (formation.launch scenario:=FILE)
-#   nodelet: every agent in one nodelet manager (formation.launch scenario:=FILE nodelet:=true);
+#   nodelet: every agent in one nodelet manager, agent_manager (formation.launch scenario:=FILE nodelet:=true);
 #            n/a while the launch file has no `nodelet` argument or its launch fails.
 # Each run is a ring with chords to the second neighbour written by make_scenario (spacing 1 m,
 # start perturbed by up to 0.05 m per coordinate, seed 1, kappa 2, h = 0.005 s), run as fast as
 # possible without recording, on its own ROS master (a free port in 11500-11599).
 # Columns:
 #   steps/s, real-time factor: the monitor's final line, from step 0 to the last step;
-#   CPU%/agent: CPU time of the processes hosting agents (`agent` and `nodelet` processes under
+#   CPU%/agent: CPU time of the processes hosting agents (`agent` and `agent_manager` processes under
 #     the launch, from /proc every VF_BENCH_SAMPLE s) over the monitor's stepping window,
 #     divided by the window and the agent count (100 = one core);
 #   RSS MiB/agent: the largest total resident memory of those processes, divided by the agent
 #     count.
 # usage: ./scripts/benchmark_ros.sh [agent counts...]          (default 6 20 50 100 200)
 # environment: VF_BENCH_MODES (default "process nodelet"), VF_BENCH_STEPS (steps per run;
-#   default max(300, 60000 / agents), about 5-10 s per run), VF_BENCH_TIMEOUT (s per run,
+#   default max(600, 120000 / agents), about 10-40 s per run), VF_BENCH_TIMEOUT (s per run,
 #   default 900), VF_BENCH_SAMPLE (s between samples, default 0.5).
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 vf_install_dependencies
@@ -59,7 +59,7 @@ sample_agents() {
         for (p in parent) {
           q = p
           while (q in parent && q != root && q > 1) q = parent[q]
-          if (q == root && p != root && name[p] ~ /^(agent|nodelet)$/) printf "/proc/%s/stat ", p
+          if (q == root && p != root && name[p] ~ /^(agent|nodelet|agent_manager)$/) printf "/proc/%s/stat ", p
         }
       }')
     echo "S $EPOCHREALTIME" >>"$out"
@@ -108,7 +108,7 @@ done
 
 printf '%7s %-8s %7s %9s %17s %11s %14s\n' agents mode steps "steps/s" "real-time factor" "CPU%/agent" "RSS MiB/agent"
 for n in "${counts[@]}"; do
-  steps="${VF_BENCH_STEPS:-$(( 60000 / n > 300 ? 60000 / n : 300 ))}"
+  steps="${VF_BENCH_STEPS:-$(( 120000 / n > 600 ? 120000 / n : 600 ))}"
   scenario="$tmp/ring$n.yaml"
   rosrun variational_formation make_scenario --shape ring --agents "$n" --perturb 0.05 --seed 1 \
     --steps "$steps" --name "ring$n" --out "$scenario"

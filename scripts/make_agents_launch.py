@@ -8,12 +8,14 @@ here. Prints the path it wrote (the parameter's value). On bad input: one line o
 exit status 2.
 
 usage: make_agents_launch.py --scenario FILE --out FILE [--rate R] [--order forward|reverse]
-                             [--stagger SECONDS] [--respawn true|false] [--manager NAME]
+                             [--stagger SECONDS] [--respawn true|false] [--nodelet true|false [--nodelet-threads N (0: auto)]]
                              [--mode lockstep|timed [--delay S] [--jitter S] [--loss P] [--max-age S]
                               [--seed N] [--respawn-delay S] [--robot true|false [--lag S] [--noise M]]]
 With --robot true (timed mode), each agent also gets a simulated robot, robot_sim, in
 formation/robot_<id> (odom and cmd_vel there), started at the scenario's initial position.
---manager loads every agent as a nodelet into that manager (agent.launch manager:=NAME).
+With --nodelet true (lockstep mode), every agent is a nodelet of one manager, formation/manager
+(the agent_manager node, which loads them itself; doc/distributed.md, "Nodelets"), instead of a
+node of its own.
 """
 import argparse
 import math
@@ -50,6 +52,32 @@ def boolean(flag):
             return "false"
         fail(f"{flag}: expected true or false, got '{text}'")
     return parse
+
+
+def non_negative_int(flag):
+    def parse(text):
+        try:
+            value = int(text)
+        except ValueError:
+            fail(f"{flag}: expected an integer, got '{text}'")
+        if value < 0:
+            fail(f"{flag}: must be >= 0, got {text}")
+        return text
+    return parse
+
+
+def manager(args, ids):
+    """The agents' nodelet manager, which loads every agent in `ids` (in that order) itself.
+    Worker threads 0 means: one up to 10 agents, four beyond (doc/distributed.md, "Threads")."""
+    threads = args.nodelet_threads if int(args.nodelet_threads) > 0 else ("1" if len(ids) <= 10 else "4")
+    lines = ['  <node name="manager" ns="formation" pkg="variational_formation" type="agent_manager" clear_params="true"',
+             f'        respawn={quoteattr(args.respawn)} output="screen">']
+    for name, kind, value in (("agents", "str", " ".join(str(i) for i in ids)), ("scenario", "str", args.scenario),
+                              ("real_time_factor", "double", args.rate), ("stagger", "double", args.stagger),
+                              ("num_worker_threads", "int", threads)):
+        lines.append(f"    <param name={quoteattr(name)} type={quoteattr(kind)} value={quoteattr(value)}/>")
+    lines.append("  </node>")
+    return lines
 
 
 def probability(flag):
@@ -129,11 +157,14 @@ def main():
     parser.add_argument("--respawn-delay", type=non_negative("respawn_delay"), default="0")
     parser.add_argument("--lag", type=non_negative("lag"), default="0.1")
     parser.add_argument("--noise", type=non_negative("noise"), default="0.01")
-    parser.add_argument("--manager", default="")
+    parser.add_argument("--nodelet", type=boolean("nodelet"), default="false")
+    parser.add_argument("--nodelet-threads", type=non_negative_int("nodelet_threads"), default="0")
     parser.error = lambda message: fail(message.replace("argument --", ""))
     args = parser.parse_args()
     if args.robot == "true" and args.mode != "timed":
         fail("robot: robots need mode timed")
+    if args.nodelet == "true" and args.mode != "lockstep":
+        fail("nodelet: only lockstep agents are nodelets; run timed agents as nodes (nodelet:=false)")
     if args.mode == "timed" and float(args.rate) <= 0:
         fail(f"rate: must be > 0 in timed mode (the tick period is h / rate), got {args.rate}")
     count = agent_count(args.scenario, args.rate)
@@ -142,13 +173,15 @@ def main():
         ids.reverse()
     lines = ["<launch>",
              f"  <!-- written by make_agents_launch.py for {args.scenario}: {count} agents -->"]
+    if args.nodelet == "true":
+        lines += manager(args, ids)
+        ids = []
     for position, i in enumerate(ids):
         delay = position * float(args.stagger)
         prefix = f"bash -c 'sleep {delay:g}; exec \"$0\" \"$@\"'" if delay > 0 else ""
         lines.append('  <include file="$(find variational_formation)/launch/agent.launch">')
         for name, value in (("id", str(i)), ("scenario", args.scenario), ("rate", args.rate),
-                            ("respawn", args.respawn), ("launch_prefix", prefix)) + timed_args(args, i) + \
-                ((("manager", args.manager),) if args.manager else ()):
+                            ("respawn", args.respawn), ("launch_prefix", prefix)) + timed_args(args, i):
             lines.append(f"    <arg name={quoteattr(name)} value={quoteattr(value)}/>")
         lines.append("  </include>")
         if args.robot == "true":

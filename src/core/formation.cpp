@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <string>
 
@@ -192,6 +193,47 @@ bool Formation::isCongruent(const Positions& q, const Velocities& v, double tole
       const double actual = (q.col(i) - q.col(j)).norm();
       if (!(std::abs(actual - desired) <= tolerance * desired)) return false;
     }
+  }
+  return true;
+}
+
+bool CongruenceTracker::check(const Formation& formation, const Positions& q, const Velocities& v) {
+  const int n = formation.agentCount();
+  for (int i = 0; i < n; ++i) {
+    if (!(v.col(i).norm() < maxSpeed_)) return false;
+  }
+  if (anchored_) {
+    double first = 0.0, second = 0.0;  // the two largest displacements from the anchor
+    for (int i = 0; i < n; ++i) {
+      const double d = (q.col(i) - anchor_.col(i)).norm();
+      if (d > first) {
+        second = first;
+        first = d;
+      } else if (d > second) {
+        second = d;
+      }
+    }
+    if (first + second <= 0.5 * slack_) return true;
+  }
+  // The full test, as isCongruent's pair loop, keeping the smallest slack and the largest distance.
+  ++fullTests_;
+  anchored_ = false;
+  const Positions& shape = formation.desiredShape();
+  double slack = std::numeric_limits<double>::infinity(), largest = 0.0;
+  for (int i = 0; i < n; ++i) {
+    for (int j = i + 1; j < n; ++j) {
+      const double desired = (shape.col(i) - shape.col(j)).norm();
+      const double actual = (q.col(i) - q.col(j)).norm();
+      if (!(std::abs(actual - desired) <= tolerance_ * desired)) return false;
+      slack = std::min(slack, tolerance_ * desired - std::abs(actual - desired));
+      largest = std::max(largest, desired);
+    }
+  }
+  // A slack at the level of rounding certifies nothing: keep testing in full then.
+  if (slack > 1e-9 * largest && std::isfinite(slack)) {
+    anchored_ = true;
+    anchor_ = q;
+    slack_ = slack;
   }
   return true;
 }

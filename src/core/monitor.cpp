@@ -12,7 +12,8 @@ FormationMonitor::FormationMonitor(const Scenario& scenario, double tolerance, d
       formation_(makeFormation(scenario)),
       coefficients_(scenario.timeStep, scenario.dampingGain),
       tolerance_(tolerance),
-      maxSpeed_(maxSpeed) {
+      maxSpeed_(maxSpeed),
+      congruence_(tolerance, maxSpeed) {
   p0_ = linearMomentum(scenario.initialVelocities);
   a0_ = angularMomentum(scenario.initialPositions, scenario.initialVelocities);
 }
@@ -109,7 +110,7 @@ FormationSnapshot FormationMonitor::measureStep(long step, const Positions& qPre
   s.angularMomentumPredicted = noetherPrediction(a0_, coefficients_, step);
   s.edgeDistanceErrors = formation_.distanceErrors(q);
   s.positions = q;
-  s.converged = formation_.isCongruent(q, v, tolerance_, maxSpeed_);
+  s.converged = congruence_.check(formation_, q, v);
   if (!s.converged) {
     congruentSince_ = -1;
   } else if (congruentSince_ < 0) {

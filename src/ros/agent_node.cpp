@@ -24,7 +24,7 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   agent_ = std::make_unique<LockstepAgent>(scenario, id);
   name_ = "agent_" + std::to_string(id);
   // Frames carry the namespace, so that two formations side by side have distinct frames.
-  const std::string ns = nh.getNamespace() == "/" ? "" : nh.getNamespace().substr(1) + "/";
+  const std::string ns = framePrefix(nh);
   frame_ = ns + name_;
   managers_ = agentManagers(nh, pnh);
   statePub_ = nh.advertise<AgentState>(name_ + "/state", 1000, /*latch=*/true);

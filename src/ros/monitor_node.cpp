@@ -68,7 +68,7 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   markersPub_ = nh.advertise<visualization_msgs::MarkerArray>("markers", 1000, true);
   progressPub_ = nh.advertise<RunProgress>("progress", 10, true);
   for (int i = 0; i < n; ++i) {
-    agents_.push_back({agentNodeName(nh, i), false, ros::WallTime()});
+    agents_.push_back({agentNodeName(nh, i), false, ros::WallTime(), ""});
     subs_.push_back(nh.subscribe<AgentState>(
         "agent_" + std::to_string(i) + "/state", static_cast<uint32_t>(2 * window_ + 10),
         boost::function<void(const ros::MessageEvent<AgentState const>&)>(
@@ -113,6 +113,7 @@ void MonitorNode::onState(int agent, const ros::MessageEvent<AgentState const>& 
   } else if (timed_) {
     if (acceptTimed(agent, msg, why)) {
       owner.seen = true;
+      owner.host = event.getPublisherName();
       owner.goneSince = ros::WallTime();
       return;
     }
@@ -125,6 +126,7 @@ void MonitorNode::onState(int agent, const ros::MessageEvent<AgentState const>& 
           unrecordedStates_[static_cast<std::size_t>(agent)].push_back(msg);
         }
         owner.seen = true;
+        owner.host = event.getPublisherName();
         owner.goneSince = ros::WallTime();
         if (receipt == FormationMonitor::Receipt::Accepted) publishCompleted();
         return;
@@ -269,7 +271,8 @@ std::string MonitorNode::waitingFor() const {
 
 bool MonitorNode::checkAlive(Participant& p, const std::string& what, double timeout) {
   if (!p.seen) return true;  // not started yet: the waiting line says so
-  const Liveness l = nodeLiveness(p.node);
+  // An agent in a nodelet manager has no node of its own: its host is the manager.
+  const Liveness l = nodeLiveness(p.host.empty() ? p.node : p.host);
   if (l == Liveness::Alive) {
     p.goneSince = ros::WallTime();
     return true;
@@ -277,12 +280,13 @@ bool MonitorNode::checkAlive(Participant& p, const std::string& what, double tim
   if (p.goneSince.isZero()) {
     p.goneSince = ros::WallTime::now();
     if (timeout > 0.0) {
-      ROS_WARN("monitor: %s %s is gone (%s); waiting up to %.1f s for it to come back", what.c_str(), p.node.c_str(),
-               describe(l), timeout);
+      ROS_WARN("monitor: %s %s is gone (%s%s); waiting up to %.1f s for it to come back", what.c_str(), p.node.c_str(),
+               describe(l), p.host.empty() || p.host == p.node ? "" : (", its host " + p.host).c_str(), timeout);
     }
   }
   if (secondsSince(p.goneSince) < timeout) return true;
-  finish(RunProgress::FAILED, what + " " + p.node + " ended before the run was over (" + describe(l) + ")");
+  finish(RunProgress::FAILED, what + " " + p.node + " ended before the run was over (" + describe(l) +
+                                  (p.host.empty() || p.host == p.node ? "" : ", its host " + p.host) + ")");
   return false;
 }
 

@@ -20,6 +20,12 @@ std::string agentNodeName(const ros::NodeHandle& nh, int id) {
   return participantName(nh, "agent_" + std::to_string(id));
 }
 
+std::string framePrefix(const ros::NodeHandle& nh) {
+  std::string ns = nh.getNamespace();
+  while (!ns.empty() && ns.front() == '/') ns.erase(0, 1);
+  return ns.empty() ? "" : ns + "/";
+}
+
 std::string participantName(const ros::NodeHandle& nh, const std::string& relative) {
   return nh.resolveName(relative, /*remap=*/false);
 }

@@ -50,7 +50,7 @@ RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) 
   maxBytes_ = maxMb * 1e6;
   createParentDirectory(path_, "~bag");
   openPart();
-  const std::string ns = nh.getNamespace() == "/" ? "" : nh.getNamespace().substr(1) + "/";
+  const std::string ns = framePrefix(nh);
   framePrefix_ = ns;
   for (int i = 0; i < n; ++i) {
     owners_.push_back(agentNodeName(nh, i));

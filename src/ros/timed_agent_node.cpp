@@ -46,7 +46,7 @@ TimedAgentNode::TimedAgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   faults_ = std::make_unique<LinkFaults<Received>>(faults, static_cast<std::uint64_t>(seed));
   h_ = scenario.timeStep;
   name_ = "agent_" + std::to_string(id);
-  const std::string ns = nh.getNamespace() == "/" ? "" : nh.getNamespace().substr(1) + "/";
+  const std::string ns = framePrefix(nh);
   frame_ = ns + name_;
   statePub_ = nh.advertise<AgentState>(name_ + "/state", 100, /*latch=*/true);
   posePub_ = nh.advertise<geometry_msgs::PoseStamped>(name_ + "/pose", 10);

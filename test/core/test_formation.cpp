@@ -6,6 +6,7 @@
 
 #include "test_support.hpp"
 #include "variational_formation/core/error.hpp"
+#include "variational_formation/core/integrator.hpp"
 
 namespace vf {
 namespace {
@@ -154,6 +155,54 @@ TEST(Congruence, RigidMotionsAndReflectionsAreCongruent) {
   Positions mirrored = f.desiredShape();
   mirrored.row(2) *= -1.0;
   EXPECT_TRUE(f.isCongruent(mirrored, still));
+}
+
+// The tracker answers exactly as isCongruent along a converging run of the hexagon (kappa 2,
+// 4000 steps, congruent from step ~800 on), and the full pair test runs on few of its steps.
+TEST(Congruence, TrackerEqualsTheFullTestAlongARun) {
+  const Scenario sc = loadScenario(test::configPath("hexagon"));
+  const Formation f = makeFormation(sc);
+  const auto integ = makeIntegrator(Method::Variational, f, sc.initialPositions, sc.initialVelocities, sc.timeStep,
+                                    sc.dampingGain);
+  CongruenceTracker tracker(0.01, 0.1);
+  long congruent = 0;
+  const long steps = 4000;
+  for (long k = 0; k <= steps; ++k) {
+    if (k > 0) integ->step();
+    const bool full = f.isCongruent(integ->positions(), integ->velocities());
+    ASSERT_EQ(tracker.check(f, integ->positions(), integ->velocities()), full) << "step " << k;
+    congruent += full ? 1 : 0;
+  }
+  ASSERT_GT(congruent, steps / 2);
+  // Every congruent step would cost a full test without the anchor; the run settles, so the
+  // displacements stay far below the slack and a few percent of them do.
+  EXPECT_LT(tracker.fullTests(), congruent / 20)
+      << tracker.fullTests() << " full tests, " << congruent << " congruent steps";
+}
+
+// A random walk of a tetrahedron's positions around the tolerance boundary (every third step up
+// to 0.2% of a side, the others 1000 times smaller, pulled back to the desired shape): the
+// tracker agrees with isCongruent at every step, on both outcomes, and skips the full test on
+// some congruent steps.
+TEST(Congruence, TrackerEqualsTheFullTestOnARandomWalk) {
+  const Formation f = test::tetrahedron();
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> step(-0.004, 0.004);
+  CongruenceTracker tracker(0.01, 0.1);
+  Positions q = f.desiredShape();
+  const Velocities still = Velocities::Zero(3, 4);
+  long yes = 0, no = 0;
+  for (int k = 0; k < 20000; ++k) {
+    for (int i = 0; i < q.rows(); ++i) {
+      for (int j = 0; j < q.cols(); ++j) q(i, j) += step(rng) * (k % 3 == 0 ? 1.0 : 1e-3) - 0.01 * (q(i, j) - f.desiredShape()(i, j));
+    }
+    const bool full = f.isCongruent(q, still);
+    ASSERT_EQ(tracker.check(f, q, still), full) << "step " << k;
+    (full ? yes : no)++;
+  }
+  EXPECT_GT(yes, 1000);
+  EXPECT_GT(no, 1000);
+  EXPECT_GT(20000 - tracker.fullTests(), 1000) << tracker.fullTests() << " full tests";  // steps answered by the anchor
 }
 
 TEST(Congruence, DistanceAndSpeedThresholds) {

@@ -10,6 +10,8 @@ subprocesses, on the test's master), with real faults.
 - Agents started first, each by its own agent.launch (as on robots), with stray subscribers on
   their topics, wait for the monitor and recorder started later (agents:=false): the bag is still
   complete and equals simulate.
+- agent.launch manager:=NAME: three agents loaded as nodelets into a manager started by hand,
+  three as nodes, run with formation.launch agents:=false agent_manager:=NAME: equals simulate.
 - Flow control: while the monitor is stopped (SIGSTOP), no agent runs past the allowed step.
 - A bad node parameter is one ROS_FATAL line naming it and exit status 2.
 - A diverging scenario ends the run within seconds, with one line naming the agent and the step
@@ -114,6 +116,10 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
             ([f"scenario:={bad_edge}"], "make_agents_launch: error:", "edges[9]: agent 9 does not exist"),
             ([f"scenario:={SCENARIO}", "order:=sideways"], "make_agents_launch: error:", "order: invalid choice"),
             ([f"scenario:={SCENARIO}", "rate:=-1"], "make_agents_launch: error:", "rate: must be a finite number >= 0"),
+            ([f"scenario:={SCENARIO}", "nodelet:=true", "mode:=timed", "rate:=1"], "make_agents_launch: error:",
+             "nodelet: only lockstep agents are nodelets"),
+            ([f"scenario:={SCENARIO}", "nodelet:=true", "nodelet_threads:=-1"], "make_agents_launch: error:",
+             "nodelet_threads: must be >= 0"),
             ([f"scenario:={SCENARIO}", "output_dir:=/etc/hostname/out"], "FATAL",
              "~result_file: cannot create the directory"),
         )
@@ -186,6 +192,35 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
                     p.wait(timeout=30)
         self.assertTrue(all("waiting for the monitor /formation/monitor to start the run" in log for log in logs),
                         logs[0][-2000:])
+        rec = vf_rostest.Recording(os.path.join(out, SCENARIO + ".bag"))
+        self.check_recording(rec, self.scenario, vf_rostest.simulate(self.path))
+
+    def test_agents_loaded_into_a_manager_elsewhere_beside_agent_nodes(self):
+        """agent.launch manager:=NAME: agents 0-2 are nodelets of a manager started by hand (as on
+        a robot or host), agents 3-5 are nodes; they accept each other's states, and the run
+        recorded by formation.launch agents:=false agent_manager:=NAME equals simulate."""
+        out = os.path.join(self.tmp, "managed")
+        manager = start(["rosrun", "nodelet", "nodelet", "manager", "__name:=host_b", "__ns:=formation"])
+        agents = [start(["roslaunch", PKG, "agent.launch", f"id:={i}", f"scenario:={SCENARIO}",
+                         "manager:=host_b" if i < 3 else "agent_manager:=host_b"])
+                  for i in range(self.scenario["n"])]
+        try:
+            for i in range(self.scenario["n"]):
+                msg = rospy.wait_for_message(f"/formation/agent_{i}/state", AgentState, timeout=60)
+                # A nodelet's states carry its manager's name as caller id.
+                self.assertEqual(msg._connection_header["callerid"],
+                                 "/formation/host_b" if i < 3 else f"/formation/agent_{i}")
+            run = run_formation(f"scenario:={SCENARIO}", "agents:=false", "record:=true", "agent_manager:=host_b",
+                                f"output_dir:={out}")
+            self.assertEqual(run.returncode, 0, run.stdout[-3000:] + run.stderr[-2000:])
+            dropped = [int(k) for k in re.findall(r"(\d+) dropped", run.stdout + run.stderr)]
+            self.assertTrue(dropped, run.stdout[-2000:])
+            self.assertEqual(max(dropped), 0, run.stdout[-3000:])
+        finally:
+            for p in agents + [manager]:
+                if p.poll() is None:
+                    os.killpg(p.pid, signal.SIGINT)
+                    p.wait(timeout=30)
         rec = vf_rostest.Recording(os.path.join(out, SCENARIO + ".bag"))
         self.check_recording(rec, self.scenario, vf_rostest.simulate(self.path))
 
@@ -304,7 +339,13 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
                  ("agent", ["_id:=1", "_real_time_factor:=inf"], "~real_time_factor"),
                  ("agent", ["_id:=1", "_real_time_factor:=fast"], "~real_time_factor: expected a number"),
                  ("agent", ["_id:=99"], "id: must be an agent id 0..5, got 99"),
-                 ("agent", [], "~id: required parameter missing"))
+                 ("agent", [], "~id: required parameter missing"),
+                 ("agent_manager", [], "~agents: required parameter missing"),
+                 ("agent_manager", ["_agents:=0 x"], "~agents: 'x' is not an agent id"),
+                 ("agent_manager", ["_agents:=2 1 2"], "~agents: agent 2 is listed twice"),
+                 ("agent_manager", ["_agents:=1 99"], "id: must be an agent id 0..5, got 99"),
+                 ("agent_manager", ["_agents:=1", "_stagger:=-1"], "~stagger: must be >= 0"),
+                 ("agent_manager", ["_agents:=4", "_real_time_factor:=fast"], "~real_time_factor: expected a number"))
         for k, (node, params, words) in enumerate(cases):
             # A fresh node name each time: private parameters stay on the master after a run.
             run = subprocess.run(["rosrun", PKG, node, f"__name:=param_probe_{k}", f"_scenario:={self.path}",

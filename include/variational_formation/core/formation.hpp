@@ -89,6 +89,31 @@ class Formation {
   std::vector<std::vector<Neighbour>> neighbours_;
 };
 
+/**
+ * Formation::isCongruent for a sequence of configurations (the monitor's steps) at an amortised
+ * O(n) per call instead of O(n^2) once the formation holds its shape. Always the same answer as
+ * isCongruent: after a full pair test that passes, it keeps the configuration (the anchor) and
+ * the smallest slack s = min over pairs of (tol d_ij - |a_ij - d_ij|). A pair distance moves by
+ * at most D_i + D_j, the agents' displacements from the anchor (triangle inequality), so while
+ * the two largest displacements sum to at most s/2 every pair still passes, with s/2 to spare
+ * for rounding; otherwise it runs the full test again.
+ */
+class CongruenceTracker {
+ public:
+  CongruenceTracker(double tolerance, double maxSpeed) : tolerance_(tolerance), maxSpeed_(maxSpeed) {}
+  /// formation.isCongruent(q, v, tolerance, maxSpeed), for one formation throughout.
+  bool check(const Formation& formation, const Positions& q, const Velocities& v);
+  /// How many full O(n^2) pair tests check() ran.
+  long fullTests() const { return fullTests_; }
+
+ private:
+  double tolerance_, maxSpeed_;
+  bool anchored_ = false;
+  Positions anchor_;
+  double slack_ = 0.0;
+  long fullTests_ = 0;
+};
+
 /// The number dn - d(d+1)/2 of independent edges a rigid framework of n >= d+1 agents needs.
 int rigidEdgeCount(int dimension, int agentCount);
 

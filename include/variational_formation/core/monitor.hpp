@@ -68,6 +68,7 @@ class FormationMonitor {
   Formation formation_;
   VariationalCoefficients coefficients_;
   double tolerance_, maxSpeed_;
+  CongruenceTracker congruence_;  // isCongruent at amortised O(n) per step
   std::map<long, Pending> pending_;
   long next_ = 0;
   long congruentSince_ = -1;

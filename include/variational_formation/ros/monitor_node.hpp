@@ -63,6 +63,7 @@ class MonitorNode {
     std::string node;            // full node name
     bool seen = false;           // has sent a valid message
     ros::WallTime goneSince;     // zero while alive
+    std::string host;            // the node its messages came from: itself, or its nodelet manager
   };
   void recover();
   std::vector<RecallHistory::Response> fetchHistories(const std::vector<int>& agents);

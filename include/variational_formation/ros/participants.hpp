@@ -10,6 +10,10 @@ namespace vf {
 /// Full name of the node that owns agent `id` in the namespace of `nh` ("/formation/agent_3").
 std::string agentNodeName(const ros::NodeHandle& nh, int id);
 
+/// The prefix of frame names in the namespace of `nh`: "formation/" in /formation, "" in the
+/// root namespace (which a nodelet's handle spells "" and a node's "/").
+std::string framePrefix(const ros::NodeHandle& nh);
+
 /// Full name of a participant node given relative to the namespace of `nh` (e.g. "monitor").
 std::string participantName(const ros::NodeHandle& nh, const std::string& relative);
 

@@ -1,0 +1,101 @@
+// The agents' nodelet manager (formation.launch nodelet:=true, doc/distributed.md, "Nodelets"):
+// a nodelet manager that loads its own agents at start. A respawned manager therefore brings
+// every agent back by itself, with no `nodelet load` process and no bond per agent (bonds time
+// out under load, and a respawned loader clashes with its old name). It is still an ordinary
+// manager: `nodelet load TYPE <this manager>` (agent.launch manager:=NAME) adds more nodelets.
+//
+// Private parameters:
+//   ~agents             ids of the agents to load, separated by spaces (required)
+//   ~scenario, ~real_time_factor, ~monitor, ~agent_manager
+//                       passed to every agent as its private parameters (AgentNode checks them)
+//   ~stagger            seconds between two loads (default 0)
+//   ~num_worker_threads the manager's worker threads (nodelet's own parameter, default 4)
+#include <cmath>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nodelet/loader.h>
+#include <ros/ros.h>
+
+#include "variational_formation/core/error.hpp"
+#include "variational_formation/ros/parameters.hpp"
+
+namespace {
+
+std::vector<int> agentIds(const std::string& list) {
+  std::istringstream words(list);
+  std::vector<int> ids;
+  std::set<int> seen;
+  for (std::string w; words >> w;) {
+    std::size_t used = 0;
+    int id = -1;
+    try {
+      id = std::stoi(w, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != w.size() || id < 0) throw vf::InvalidInput("~agents: '" + w + "' is not an agent id (an integer >= 0)");
+    if (!seen.insert(id).second) throw vf::InvalidInput("~agents: agent " + w + " is listed twice");
+    ids.push_back(id);
+  }
+  if (ids.empty()) throw vf::InvalidInput("~agents: no agent ids in '" + list + "'");
+  return ids;
+}
+
+/// ~agents as text: a list in a string ("0 1 2"), or one id.
+std::string agentList(const ros::NodeHandle& pnh) {
+  XmlRpc::XmlRpcValue value;
+  if (!pnh.getParam("agents", value)) throw vf::InvalidInput("~agents: required parameter missing");
+  if (value.getType() == XmlRpc::XmlRpcValue::TypeInt) return std::to_string(static_cast<int>(value));
+  if (value.getType() != XmlRpc::XmlRpcValue::TypeString) {
+    throw vf::InvalidInput("~agents: expected agent ids separated by spaces, got a value of another type");
+  }
+  return static_cast<std::string>(value);
+}
+
+/// Sets agent `id`'s private parameters (after clearing what an earlier run left there).
+void setAgentParameters(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, int id) {
+  const std::string ns = "agent_" + std::to_string(id);
+  nh.deleteParam(ns);
+  ros::NodeHandle agent(nh, ns);
+  agent.setParam("id", id);
+  agent.setParam("mode", std::string("lockstep"));
+  for (const char* key : {"scenario", "real_time_factor", "monitor"}) {
+    XmlRpc::XmlRpcValue value;
+    if (pnh.getParam(key, value)) agent.setParam(key, value);
+  }
+  // The agents' states carry this manager's name as caller id; their neighbours may be in others.
+  agent.setParam("agent_manager", ros::this_node::getName() + " " + vf::optionalParam<std::string>(pnh, "agent_manager", ""));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "manager");
+  ros::NodeHandle nh, pnh("~");
+  const std::string me = ros::this_node::getName();
+  try {
+    const std::vector<int> ids = agentIds(agentList(pnh));
+    const double stagger = vf::optionalParam(pnh, "stagger", 0.0);
+    if (!(stagger >= 0.0 && std::isfinite(stagger))) throw vf::InvalidInput("~stagger: must be >= 0 seconds");
+    nodelet::Loader loader(pnh);  // the load_nodelet, unload_nodelet and list services, on the global queue
+    ros::AsyncSpinner spinner(1);
+    spinner.start();
+    for (std::size_t k = 0; k < ids.size() && ros::ok(); ++k) {
+      if (k > 0 && stagger > 0.0) ros::WallDuration(stagger).sleep();
+      setAgentParameters(nh, pnh, ids[k]);
+      const std::string name = nh.resolveName("agent_" + std::to_string(ids[k]));
+      // A nodelet that cannot start has said why in its own FATAL line (the loader, for a
+      // missing plugin, in an ERROR line): exit without a second line.
+      if (!loader.load(name, "variational_formation/Agent", ros::M_string(), std::vector<std::string>())) return 2;
+    }
+    ROS_INFO("%s: %zu agents loaded", me.c_str(), ids.size());
+    ros::waitForShutdown();
+  } catch (const std::exception& e) {
+    ROS_FATAL("%s: %s", me.c_str(), e.what());
+    return 2;
+  }
+  return 0;
+}
