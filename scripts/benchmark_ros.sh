@@ -30,21 +30,6 @@ timeout_s="${VF_BENCH_TIMEOUT:-900}"
 sample_s="${VF_BENCH_SAMPLE:-0.5}"
 monitor_line='monitor: [0-9]+ steps in'
 
-# A port in 11500-11599 that nothing listens on, starting from a different one per call.
-port_offset=$(( $$ % 100 ))
-free_port() {
-  local k p
-  for k in $(seq 0 99); do
-    p=$(( 11500 + (port_offset + k) % 100 ))
-    if ! (exec 3<>"/dev/tcp/127.0.0.1/$p") 2>/dev/null; then
-      port_offset=$(( (port_offset + k + 1) % 100 ))
-      echo "$p"
-      return 0
-    fi
-  done
-  echo "benchmark_ros: no free port in 11500-11599" >&2
-  return 1
-}
 
 # Every VF_BENCH_SAMPLE s until the launch ends or the monitor's final line is in the log:
 # "S <time>" then "P <pid> <utime+stime ticks> <rss KiB>" per agent-hosting process under
@@ -117,7 +102,7 @@ for n in "${counts[@]}"; do
       printf '%7s %-8s %7s %9s %17s %11s %14s\n' "$n" "$m" "$steps" n/a n/a n/a n/a
       continue
     fi
-    port="$(free_port)"
+    port="$(vf_free_port 11500 100)"
     log="$tmp/log_${m}_$n" samples="$tmp/samples_${m}_$n"
     : >"$samples"
     extra=()

@@ -69,3 +69,18 @@ vf_source() {
   source "$WS/devel/setup.bash"
   set -u
 }
+
+# A TCP port in [base, base + count) that nothing on this host listens on, for a ROS master of
+# our own; the search starts at a place that depends on the calling process.
+vf_free_port() {
+  local base="$1" count="$2" offset=$(( $$ % $2 )) k p
+  for k in $(seq 0 $(( count - 1 ))); do
+    p=$(( base + (offset + k) % count ))
+    if ! (exec 3<>"/dev/tcp/127.0.0.1/$p") 2>/dev/null; then
+      echo "$p"
+      return 0
+    fi
+  done
+  echo "no free port in $base-$(( base + count - 1 ))" >&2
+  return 1
+}

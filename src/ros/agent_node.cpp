@@ -19,7 +19,7 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   const std::string path = requiredParam<std::string>(pnh, "scenario");
   realTimeFactor_ = optionalParam(pnh, "real_time_factor", 0.0);
   monitor_ = participantName(nh, optionalParam<std::string>(pnh, "monitor", "monitor"));
-  const Scenario scenario = loadScenario(path);
+  const Scenario scenario = sharedScenario(path);
   validateRealTimeFactor(realTimeFactor_, scenario.timeStep, "~real_time_factor");
   agent_ = std::make_unique<LockstepAgent>(scenario, id);
   name_ = "agent_" + std::to_string(id);

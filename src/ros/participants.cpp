@@ -8,6 +8,9 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
+#include <map>
+#include <mutex>
 #include <sstream>
 
 #include <ros/master.h>
@@ -18,6 +21,20 @@ namespace vf {
 
 std::string agentNodeName(const ros::NodeHandle& nh, int id) {
   return participantName(nh, "agent_" + std::to_string(id));
+}
+
+Scenario sharedScenario(const std::string& path) {
+  static std::mutex mutex;
+  static std::map<std::string, Scenario> loaded;  // by path and content
+  std::ifstream file(path);
+  std::ostringstream content;
+  content << file.rdbuf();
+  if (!file) return loadScenario(path);  // its error names the file
+  const std::string key = path + '\n' + content.str();
+  const std::lock_guard<std::mutex> lock(mutex);
+  const auto found = loaded.find(key);
+  if (found != loaded.end()) return found->second;
+  return loaded.emplace(key, loadScenario(path)).first->second;
 }
 
 std::string framePrefix(const ros::NodeHandle& nh) {

@@ -5,6 +5,8 @@
 
 #include <ros/ros.h>
 
+#include "variational_formation/core/scenario.hpp"
+
 namespace vf {
 
 /// Full name of the node that owns agent `id` in the namespace of `nh` ("/formation/agent_3").
@@ -13,6 +15,13 @@ std::string agentNodeName(const ros::NodeHandle& nh, int id);
 /// The prefix of frame names in the namespace of `nh`: "formation/" in /formation, "" in the
 /// root namespace (which a nodelet's handle spells "" and a node's "/").
 std::string framePrefix(const ros::NodeHandle& nh);
+
+/**
+ * loadScenario(path), parsed and checked once per content in this process: the agents of one
+ * nodelet manager all load the same file, and its rigidity test costs O(n^3) (0.05 s at 200
+ * agents). A file that changed is loaded again; an error is thrown as loadScenario throws it.
+ */
+Scenario sharedScenario(const std::string& path);
 
 /// Full name of a participant node given relative to the namespace of `nh` (e.g. "monitor").
 std::string participantName(const ros::NodeHandle& nh, const std::string& relative);
