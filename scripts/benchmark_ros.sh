@@ -30,7 +30,6 @@ timeout_s="${VF_BENCH_TIMEOUT:-900}"
 sample_s="${VF_BENCH_SAMPLE:-0.5}"
 monitor_line='monitor: [0-9]+ steps in'
 
-
 # Every VF_BENCH_SAMPLE s until the launch ends or the monitor's final line is in the log:
 # "S <time>" then "P <pid> <utime+stime ticks> <rss KiB>" per agent-hosting process under
 # root; "E <time>" when it stops.
