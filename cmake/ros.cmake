@@ -37,7 +37,9 @@ if(CATKIN_ENABLE_TESTING)
     "scenario:=hexagon order:=reverse stagger:=1"
     "scenario:=hexagon rate:=1 inject:=true"
     "scenario:=hexagon nodelet:=true"
-    "scenario:=grid24 nodelet:=true")
+    "scenario:=grid24 nodelet:=true"
+    # Scale: a 3D lattice of 48 agents written by make_scenario, all in one manager.
+    "scenario:=lattice48 nodelet:=true")
   foreach(case ${VF_RUN_CASES})
     separate_arguments(args UNIX_COMMAND "${case}")
     add_rostest(test/ros/distributed_run.test ARGS ${args})

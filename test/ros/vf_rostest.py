@@ -78,19 +78,24 @@ class Recording:
         self.states, self.status, self.tf, self.topics = {}, {}, {}, set()
         self.marker_stamps = []  # one per marker array (a republished one repeats its stamp)
         self.bag_times = []
-        with rosbag.Bag(bag_path) as bag:
-            for topic, msg, t in bag.read_messages():
-                self.topics.add(topic)
-                if topic.startswith(ns + "/agent_") and topic.endswith("/state"):
-                    self.states.setdefault((msg.id, msg.step), []).append(msg)
-                    self.bag_times.append((t, msg.header.stamp))
-                elif topic == ns + "/status":
-                    self.status.setdefault(msg.step, []).append(msg)
-                elif topic == ns + "/markers":
-                    self.marker_stamps.append(msg.markers[0].header.stamp.to_sec() if msg.markers else -1.0)
-                elif topic == "/tf":
-                    for x in msg.transforms:
-                        self.tf.setdefault(x.child_frame_id, []).append(x)
+        # A long run is split into <name>.bag, <name>_1.bag, ... (record_split_size): read them all.
+        parts, stem = [bag_path], bag_path[:-len(".bag")] if bag_path.endswith(".bag") else bag_path
+        while os.path.exists(f"{stem}_{len(parts)}.bag"):
+            parts.append(f"{stem}_{len(parts)}.bag")
+        for part in parts:
+            with rosbag.Bag(part) as bag:
+                for topic, msg, t in bag.read_messages():
+                    self.topics.add(topic)
+                    if topic.startswith(ns + "/agent_") and topic.endswith("/state"):
+                        self.states.setdefault((msg.id, msg.step), []).append(msg)
+                        self.bag_times.append((t, msg.header.stamp))
+                    elif topic == ns + "/status":
+                        self.status.setdefault(msg.step, []).append(msg)
+                    elif topic == ns + "/markers":
+                        self.marker_stamps.append(msg.markers[0].header.stamp.to_sec() if msg.markers else -1.0)
+                    elif topic == "/tf":
+                        for x in msg.transforms:
+                            self.tf.setdefault(x.child_frame_id, []).append(x)
 
 
 class RunChecks:
