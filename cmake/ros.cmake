@@ -46,7 +46,10 @@ if(CATKIN_ENABLE_TESTING)
   endforeach()
   # Real faults (signals to the real processes) during recorded runs: test/ros/fault.test.
   foreach(case "fault:=kill_agent seed:=3" "fault:=kill_agent_twice seed:=5" "fault:=kill_two seed:=2"
-               "fault:=stop_agent seed:=4" "fault:=kill_monitor seed:=6" "fault:=kill_recorder seed:=7")
+               "fault:=stop_agent seed:=4" "fault:=kill_monitor seed:=6" "fault:=kill_recorder seed:=7"
+               # 20 kills of one agent, unpaced: a state of a dead incarnation may be held only by
+               # its neighbours (doc/distributed.md, recovery).
+               "fault:=kill_agent kills:=20 seed:=17 rate:=0 test_scenario:=hexagon3000")
     separate_arguments(args UNIX_COMMAND "${case}")
     add_rostest(test/ros/fault.test ARGS ${args})
   endforeach()

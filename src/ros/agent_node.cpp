@@ -1,5 +1,7 @@
 #include "variational_formation/ros/agent_node.hpp"
 
+#include <algorithm>
+
 #include <geometry_msgs/TransformStamped.h>
 #include <ros/callback_queue.h>
 
@@ -29,6 +31,7 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   managers_ = agentManagers(nh, pnh);
   statePub_ = nh.advertise<AgentState>(name_ + "/state", 1000, /*latch=*/true);
   for (int j : agent_->neighbourIds()) neighbourOwners_.push_back(agentNodeName(nh, j));
+  neighbourHistory_.resize(agent_->neighbourIds().size());
   // Served from the start, so that restarting neighbours can ask; the subscriptions wait for
   // start(), which resumes the agent before any state reaches it.
   recallServer_ = nh.advertiseService(name_ + "/recall", &AgentNode::onRecall, this);
@@ -58,6 +61,7 @@ void AgentNode::onNeighbourState(int neighbour, const ros::MessageEvent<AgentSta
     const long sender = static_cast<long>(msg.id) == neighbour ? neighbour : -1;
     const auto receipt = agent_->receive(sender, msg.step, msg.position, msg.previous_position);
     if (receipt == LockstepAgent::Receipt::Accepted) {
+      neighbourHistory_[k].push_back(event.getConstMessage());
       tryAdvance();
     } else if (receipt != LockstepAgent::Receipt::Duplicate) {
       drop("a state from agent_" + std::to_string(neighbour) + " (step " + std::to_string(msg.step) +
@@ -78,6 +82,9 @@ void AgentNode::onProgress(const ros::MessageEvent<RunProgress const>& event) {
     lastProgress_ = p;
     hasProgress_ = true;
     while (!history_.empty() && history_.front()->step <= p.completed_step) history_.pop_front();
+    for (auto& held : neighbourHistory_) {
+      while (!held.empty() && held.front()->step <= p.completed_step) held.pop_front();
+    }
   }
   if (p.state == RunProgress::FINISHED || p.state == RunProgress::FAILED) {
     // Stay up, idle: a respawning agent that exited would only be restarted.
@@ -221,8 +228,19 @@ bool AgentNode::onRecall(RecallState::Request& request, RecallState::Response& r
   return true;
 }
 
-bool AgentNode::onHistory(RecallHistory::Request&, RecallHistory::Response& response) {
-  for (const AgentState::ConstPtr& state : history_) response.states.push_back(*state);
+bool AgentNode::onHistory(RecallHistory::Request& request, RecallHistory::Response& response) {
+  // Its own states, or those it holds of the neighbour request.id.
+  const std::vector<int>& ids = agent_->neighbourIds();
+  const auto k = std::find(ids.begin(), ids.end(), static_cast<int>(request.id)) - ids.begin();
+  const std::deque<AgentState::ConstPtr>* held = nullptr;
+  if (request.id == agent_->id()) {
+    held = &history_;
+  } else if (k < static_cast<long>(ids.size())) {
+    held = &neighbourHistory_[static_cast<std::size_t>(k)];
+  }
+  if (held) {
+    for (const AgentState::ConstPtr& state : *held) response.states.push_back(*state);
+  }
   response.progress = lastProgress_;
   response.has_progress = hasProgress_;
   return true;

@@ -308,6 +308,7 @@ void MonitorNode::watch() {
     if (progress_.state != RunProgress::WAITING && !missing.empty()) {
       const auto held = fetchHistories(missing);
       for (std::size_t k = 0; k < missing.size(); ++k) addHistory(missing[k], held[k]);
+      catchUpFromNeighbours(monitor_->missingAt(monitor_->nextStep()));
       publishCompleted();
     }
     if (recording_ && !checkAlive(recorder_, "the recorder", 0.0)) return;
@@ -379,14 +380,45 @@ bool MonitorNode::onRecall(RecallState::Request& request, RecallState::Response&
 
 std::vector<RecallHistory::Response> MonitorNode::fetchHistories(const std::vector<int>& ids) {
   std::vector<std::string> services;
-  for (int i : ids) services.push_back(agents_[static_cast<std::size_t>(i)].node + "/history");
   std::vector<RecallHistory> calls(ids.size());
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    services.push_back(agents_[static_cast<std::size_t>(ids[k])].node + "/history");
+    calls[k].request.id = ids[k];
+  }
   const std::vector<bool> answered = callAllWithTimeout(services, calls, 2.0);
   std::vector<RecallHistory::Response> held(ids.size());
   for (std::size_t k = 0; k < ids.size(); ++k) {
     if (answered[k]) held[k] = calls[k].response;
   }
   return held;
+}
+
+void MonitorNode::catchUpFromNeighbours(const std::vector<int>& ids) {
+  // A state of an incarnation that died before this monitor got it is held by the neighbours
+  // that used it (until the step is complete), and nowhere else.
+  std::vector<std::string> services;
+  std::vector<RecallHistory> calls;
+  std::vector<int> whose;
+  for (int i : ids) {
+    for (const Neighbour& j : monitor_->formation().neighbours(i)) {
+      services.push_back(agents_[static_cast<std::size_t>(j.agent)].node + "/history");
+      calls.emplace_back();
+      calls.back().request.id = i;
+      whose.push_back(i);
+    }
+  }
+  const std::vector<bool> answered = callAllWithTimeout(services, calls, 2.0);
+  const long next = monitor_->nextStep();
+  for (std::size_t c = 0; c < calls.size(); ++c) {
+    if (answered[c]) addHistory(whose[c], calls[c].response);
+  }
+  for (int i : ids) {
+    const std::vector<int> still = monitor_->missingAt(next);
+    if (std::find(still.begin(), still.end(), i) == still.end()) {
+      ROS_INFO("monitor: step %ld of agent_%d came from its neighbours (the incarnation that published it is gone)",
+               next, i);
+    }
+  }
 }
 
 void MonitorNode::addHistory(int agent, const RecallHistory::Response& held) {

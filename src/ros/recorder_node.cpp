@@ -169,6 +169,7 @@ void RecorderNode::catchUp() {
   // it (an agent that died again no longer holds its states).
   std::vector<RecallHistory> calls(2 * agents.size());
   for (std::size_t k = 0; k < agents.size(); ++k) {
+    calls[k].request.id = agents[k];
     services.push_back(monitor_ + "/history");
     calls[agents.size() + k].request.id = agents[k];
   }

@@ -31,7 +31,8 @@ using variational_formation::RunProgress;
  * On start it asks its neighbours and the monitor for the newest state of its own they hold, and
  * resumes from the highest step found (crash recovery; at step 0, or when nobody holds anything,
  * it starts from the scenario). It serves the same question for its neighbours (`~recall`), and
- * its states after the monitor's last completed step for a restarted monitor (`~history`).
+ * its states after the monitor's last completed step for a restarted monitor (`~history`), and
+ * the neighbours' states it accepted after that step (`~history` with a neighbour's id).
  * It publishes its state at once (latched, step 0 included) and the tf world -> <ns>/agent_<id>;
  * it accepts a neighbour's state only from the node that owns it, and it computes step k only
  * once the monitor's latched `progress` allows k. When the monitor says the run is over it idles
@@ -87,6 +88,9 @@ class AgentNode {
   ros::Subscriber progressSub_;
   ros::ServiceServer recallServer_, historyServer_;
   std::deque<AgentState::ConstPtr> history_;  // published states after the last completed step
+  // Neighbours' states accepted after the last completed step, indexed like neighbourIds(): a
+  // state of an incarnation that died may exist nowhere else (doc/distributed.md, recovery).
+  std::vector<std::deque<AgentState::ConstPtr>> neighbourHistory_;
   RunProgress lastProgress_;
   bool hasProgress_ = false;
   long startStep_ = 0;

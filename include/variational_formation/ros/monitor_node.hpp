@@ -68,6 +68,7 @@ class MonitorNode {
   void recover();
   std::vector<RecallHistory::Response> fetchHistories(const std::vector<int>& agents);
   void addHistory(int agent, const RecallHistory::Response& held);
+  void catchUpFromNeighbours(const std::vector<int>& agents);
   bool onRecall(RecallState::Request& request, RecallState::Response& response);
   bool onHistory(RecallHistory::Request& request, RecallHistory::Response& response);
   void onState(int agent, const ros::MessageEvent<AgentState const>& event);
