@@ -181,32 +181,41 @@ double Formation::maxDistanceError(const Positions& q) const {
   return distanceErrors(q).cwiseAbs().maxCoeff();
 }
 
-bool Formation::isCongruent(const Positions& q, const Velocities& v, double tolerance,
-                            double maxSpeed) const {
-  const int n = agentCount();
-  // Speeds first, O(n): the O(n^2) pair test runs only once every agent is slow (the monitor
-  // calls this every step).
-  for (int i = 0; i < n; ++i) {
+bool Formation::allSlowerThan(const Velocities& v, double maxSpeed) const {
+  for (int i = 0; i < agentCount(); ++i) {
     if (!(v.col(i).norm() < maxSpeed)) return false;
-  }
-  for (int i = 0; i < n; ++i) {
-    for (int j = i + 1; j < n; ++j) {
-      const double desired = (desiredShape_.col(i) - desiredShape_.col(j)).norm();
-      const double actual = (q.col(i) - q.col(j)).norm();
-      if (!(std::abs(actual - desired) <= tolerance * desired)) return false;
-    }
   }
   return true;
 }
 
-bool CongruenceTracker::check(const Formation& formation, const Positions& q, const Velocities& v) {
-  const int n = formation.agentCount();
+double Formation::congruenceSlack(const Positions& q, double tolerance) const {
+  const int n = agentCount();
+  double slack = std::numeric_limits<double>::infinity();
   for (int i = 0; i < n; ++i) {
-    if (!(v.col(i).norm() < maxSpeed_)) return false;
+    for (int j = i + 1; j < n; ++j) {
+      const double desired = (desiredShape_.col(i) - desiredShape_.col(j)).norm();
+      const double error = std::abs((q.col(i) - q.col(j)).norm() - desired);
+      // Negative exactly when error > tolerance * desired (two distinct doubles never differ
+      // by 0), NaN when either is NaN: the first such pair ends the test.
+      const double pair = tolerance * desired - error;
+      if (!(pair >= 0.0)) return pair;
+      slack = std::min(slack, pair);
+    }
   }
+  return slack;
+}
+
+bool Formation::isCongruent(const Positions& q, const Velocities& v, double tolerance,
+                            double maxSpeed) const {
+  // Speeds first, O(n): the O(n^2) pair test runs only once every agent is slow.
+  return allSlowerThan(v, maxSpeed) && congruenceSlack(q, tolerance) >= 0.0;
+}
+
+bool CongruenceTracker::check(const Formation& formation, const Positions& q, const Velocities& v) {
+  if (!formation.allSlowerThan(v, maxSpeed_)) return false;
   if (anchored_) {
     double first = 0.0, second = 0.0;  // the two largest displacements from the anchor
-    for (int i = 0; i < n; ++i) {
+    for (int i = 0; i < formation.agentCount(); ++i) {
       const double d = (q.col(i) - anchor_.col(i)).norm();
       if (d > first) {
         second = first;
@@ -217,22 +226,13 @@ bool CongruenceTracker::check(const Formation& formation, const Positions& q, co
     }
     if (first + second <= 0.5 * slack_) return true;
   }
-  // The full test, as isCongruent's pair loop, keeping the smallest slack and the largest distance.
   ++fullTests_;
   anchored_ = false;
-  const Positions& shape = formation.desiredShape();
-  double slack = std::numeric_limits<double>::infinity(), largest = 0.0;
-  for (int i = 0; i < n; ++i) {
-    for (int j = i + 1; j < n; ++j) {
-      const double desired = (shape.col(i) - shape.col(j)).norm();
-      const double actual = (q.col(i) - q.col(j)).norm();
-      if (!(std::abs(actual - desired) <= tolerance_ * desired)) return false;
-      slack = std::min(slack, tolerance_ * desired - std::abs(actual - desired));
-      largest = std::max(largest, desired);
-    }
-  }
-  // A slack at the level of rounding certifies nothing: keep testing in full then.
-  if (slack > 1e-9 * largest && std::isfinite(slack)) {
+  const double slack = formation.congruenceSlack(q, tolerance_);
+  if (!(slack >= 0.0)) return false;
+  // A slack at the level of rounding (relative to the coordinates) certifies nothing: keep
+  // testing in full then.
+  if (std::isfinite(slack) && slack > 1e-9 * q.cwiseAbs().maxCoeff()) {
     anchored_ = true;
     anchor_ = q;
     slack_ = slack;

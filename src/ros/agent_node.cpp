@@ -248,18 +248,10 @@ bool AgentNode::onHistory(RecallHistory::Request& request, RecallHistory::Respon
 
 void AgentNode::start(const Recovery& recovery) {
   resume(recovery);
-  for (int j : agent_->neighbourIds()) {
-    subs_.push_back(nh_.subscribe<AgentState>(
-        "agent_" + std::to_string(j) + "/state", 1000,
-        boost::function<void(const ros::MessageEvent<AgentState const>&)>(
-            [this, j](const ros::MessageEvent<AgentState const>& e) { onNeighbourState(j, e); }),
-        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
-  }
-  progressSub_ = nh_.subscribe<RunProgress>(
-      "progress", 10,
-      boost::function<void(const ros::MessageEvent<RunProgress const>&)>(
-          [this](const ros::MessageEvent<RunProgress const>& e) { onProgress(e); }),
-      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  subscribeToFormation(
+      nh_, agent_->neighbourIds(), 1000,
+      [this](int j, const ros::MessageEvent<AgentState const>& e) { onNeighbourState(j, e); },
+      [this](const ros::MessageEvent<RunProgress const>& e) { onProgress(e); }, subs_, progressSub_);
   publish();  // the first state (step 0, or the recovered one), latched
   lastReportAt_ = ros::WallTime::now();
   watchTimer_ = nh_.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) { reportWaiting(); });

@@ -412,8 +412,8 @@ void MonitorNode::catchUpFromNeighbours(const std::vector<int>& ids) {
   for (std::size_t c = 0; c < calls.size(); ++c) {
     if (answered[c]) addHistory(whose[c], calls[c].response);
   }
+  const std::vector<int> still = monitor_->missingAt(next);
   for (int i : ids) {
-    const std::vector<int> still = monitor_->missingAt(next);
     if (std::find(still.begin(), still.end(), i) == still.end()) {
       ROS_INFO("monitor: step %ld of agent_%d came from its neighbours (the incarnation that published it is gone)",
                next, i);

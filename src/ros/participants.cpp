@@ -37,6 +37,25 @@ Scenario sharedScenario(const std::string& path) {
   return loaded.emplace(key, loadScenario(path)).first->second;
 }
 
+void subscribeToFormation(
+    ros::NodeHandle& nh, const std::vector<int>& neighbours, uint32_t stateQueue,
+    const std::function<void(int, const ros::MessageEvent<variational_formation::AgentState const>&)>& onState,
+    const std::function<void(const ros::MessageEvent<variational_formation::RunProgress const>&)>& onProgress,
+    std::vector<ros::Subscriber>& states, ros::Subscriber& progress) {
+  using variational_formation::AgentState;
+  using variational_formation::RunProgress;
+  for (int j : neighbours) {
+    states.push_back(nh.subscribe<AgentState>(
+        "agent_" + std::to_string(j) + "/state", stateQueue,
+        boost::function<void(const ros::MessageEvent<AgentState const>&)>(
+            [onState, j](const ros::MessageEvent<AgentState const>& e) { onState(j, e); }),
+        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
+  }
+  progress = nh.subscribe<RunProgress>("progress", 10,
+                                       boost::function<void(const ros::MessageEvent<RunProgress const>&)>(onProgress),
+                                       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+}
+
 std::string framePrefix(const ros::NodeHandle& nh) {
   std::string ns = nh.getNamespace();
   while (!ns.empty() && ns.front() == '/') ns.erase(0, 1);

@@ -50,19 +50,11 @@ TimedAgentNode::TimedAgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   frame_ = ns + name_;
   statePub_ = nh.advertise<AgentState>(name_ + "/state", 100, /*latch=*/true);
   posePub_ = nh.advertise<geometry_msgs::PoseStamped>(name_ + "/pose", 10);
-  for (int j : agent_->neighbourIds()) {
-    neighbourOwners_.push_back(agentNodeName(nh, j));
-    subs_.push_back(nh.subscribe<AgentState>(
-        "agent_" + std::to_string(j) + "/state", 100,
-        boost::function<void(const ros::MessageEvent<AgentState const>&)>(
-            [this, j](const ros::MessageEvent<AgentState const>& e) { onNeighbourState(j, e); }),
-        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
-  }
-  progressSub_ = nh.subscribe<RunProgress>(
-      "progress", 10,
-      boost::function<void(const ros::MessageEvent<RunProgress const>&)>(
-          [this](const ros::MessageEvent<RunProgress const>& e) { onProgress(e); }),
-      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  for (int j : agent_->neighbourIds()) neighbourOwners_.push_back(agentNodeName(nh, j));
+  subscribeToFormation(
+      nh, agent_->neighbourIds(), 100,
+      [this](int j, const ros::MessageEvent<AgentState const>& e) { onNeighbourState(j, e); },
+      [this](const ros::MessageEvent<RunProgress const>& e) { onProgress(e); }, subs_, progressSub_);
   if (robot_) {
     // Relative names in the node's private namespace' parent: remap them to a real robot's.
     odomSub_ = pnh.subscribe("odom", 10, &TimedAgentNode::onOdometry, this, ros::TransportHints().tcpNoDelay());

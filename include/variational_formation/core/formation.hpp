@@ -81,6 +81,12 @@ class Formation {
    */
   bool isCongruent(const Positions& q, const Velocities& v, double tolerance = 0.01,
                    double maxSpeed = 0.1) const;
+  /// Every agent's speed is below maxSpeed (isCongruent's speed part).
+  bool allSlowerThan(const Velocities& v, double maxSpeed) const;
+  /// isCongruent's pair part: min over all pairs of tolerance d_ij - |a_ij - d_ij| (>= 0 iff every
+  /// pair is within tolerance; +inf with fewer than two agents). It stops at the first pair
+  /// outside, and returns that pair's negative (or NaN) value.
+  double congruenceSlack(const Positions& q, double tolerance) const;
 
  private:
   int dimension_;

@@ -1,10 +1,13 @@
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
 #include <ros/ros.h>
 
+#include "variational_formation/AgentState.h"
+#include "variational_formation/RunProgress.h"
 #include "variational_formation/core/scenario.hpp"
 
 namespace vf {
@@ -22,6 +25,14 @@ std::string framePrefix(const ros::NodeHandle& nh);
  * agents). A file that changed is loaded again; an error is thrown as loadScenario throws it.
  */
 Scenario sharedScenario(const std::string& path);
+
+/// An agent's subscriptions (lockstep or timed): each neighbour's `agent_<j>/state` with queue
+/// `stateQueue`, and the monitor's `progress`, with TCP_NODELAY, callbacks on nh's queue.
+void subscribeToFormation(
+    ros::NodeHandle& nh, const std::vector<int>& neighbours, uint32_t stateQueue,
+    const std::function<void(int, const ros::MessageEvent<variational_formation::AgentState const>&)>& onState,
+    const std::function<void(const ros::MessageEvent<variational_formation::RunProgress const>&)>& onProgress,
+    std::vector<ros::Subscriber>& states, ros::Subscriber& progress);
 
 /// Full name of a participant node given relative to the namespace of `nh` (e.g. "monitor").
 std::string participantName(const ros::NodeHandle& nh, const std::string& relative);
