@@ -314,9 +314,7 @@ void MonitorNode::watch() {
     if (recording_ && !checkAlive(recorder_, "the recorder", 0.0)) return;
     // A status published while the recorder's connection was coming up (after a restart of
     // either) is lost to it: publish again what it has not recorded; it counts each step once.
-    // Not while waiting: the latched status reaches every new connection, and a repeat then
-    // would only race with it.
-    if (recording_ && progress_.state != RunProgress::WAITING && recordedStep_ < completedStep()) {
+    if (recording_ && recordedStep_ < completedStep()) {
       for (const auto& sm : unrecorded_) {
         statusPub_.publish(sm.first);
         if (!sm.second.markers.empty()) markersPub_.publish(sm.second);

@@ -157,9 +157,6 @@ void RecorderNode::catchUp() {
     return;
   }
   if (secondsSince(stalledSince_) < 1.0) return;
-  // While the monitor waits for every participant, each agent's latched step 0 reaches this
-  // recorder by itself; fetching it too would only race with it (a repeat in the bag).
-  if (monitorState_ == RunProgress::WAITING) return;
   std::vector<std::string> services;
   std::vector<int> agents;
   for (std::size_t i = 0; i < states_.size(); ++i) {
@@ -238,7 +235,6 @@ long RecorderNode::markersThrough() const {
 void RecorderNode::onMonitorProgress(const ros::MessageEvent<RunProgress const>& event) {
   if (!fromOwner(event, monitor_)) return;
   const RunProgress& p = *event.getConstMessage();
-  monitorState_ = p.state;
   if (p.state == RunProgress::FINISHED || p.state == RunProgress::FAILED) {
     close(p.state == RunProgress::FINISHED ? "finished" : "the run failed");
     exitStatus_ = 0;

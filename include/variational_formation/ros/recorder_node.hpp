@@ -73,7 +73,6 @@ class RecorderNode {
   std::vector<ros::Subscriber> subs_;
   ros::Publisher progressPub_;
   RunProgress progress_;
-  uint8_t monitorState_ = RunProgress::WAITING;  // the monitor's newest progress state
   long steps_ = 0;
   double timeStep_ = 0.0;
   std::vector<std::string> owners_;
