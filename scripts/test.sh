@@ -45,6 +45,10 @@ if [ "$status" -ne 0 ] && [ "$failed" -eq 0 ]; then
   echo "catkin_make run_tests failed; see $WS/tests.log" >&2
   failed=1
 fi
+if [ "$failed" -gt 0 ]; then
+  echo "why (the start of each failure's message; the whole log is $WS/tests.log):"
+  /usr/bin/python3 "$REPO/scripts/failure_reasons.py" "$WS/build/test_results" 400 || true
+fi
 if [ "$skipped" -gt 0 ]; then
   echo "$passed passed, $failed failed, $skipped skipped"
 else

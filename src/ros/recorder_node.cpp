@@ -14,24 +14,15 @@ namespace vf {
 
 namespace {
 constexpr uint32_t kQueue = 100000;  // far more than the monitor's window lets the agents run ahead
+// Each agent's newest states kept to compare repeats with: repeats are of steps at most one
+// window (the monitor's ~window, 100 by default) behind an agent's newest.
+constexpr long kKeptSteps = 1024;
 
 /// Bag time of a message stamped with simulated time t_k (a bag cannot hold time 0).
 ros::Time bagTime(const ros::Time& stamp) { return std::max(stamp, ros::TIME_MIN); }
 }  // namespace
 
-bool RecorderNode::Steps::holds(long step) const { return step < next || ahead.count(step) > 0; }
-
-bool RecorderNode::Steps::add(long step) {
-  if (holds(step)) return false;
-  ahead.insert(step);
-  while (!ahead.empty() && *ahead.begin() == next) {
-    ahead.erase(ahead.begin());
-    ++next;
-  }
-  return true;
-}
-
-RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
+RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), states_(1, 1) {
   const Scenario scenario = loadScenario(requiredParam<std::string>(pnh, "scenario"));
   path_ = requiredParam<std::string>(pnh, "bag");
   monitor_ = participantName(nh, optionalParam<std::string>(pnh, "monitor", "monitor"));
@@ -41,7 +32,7 @@ RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) 
   steps_ = scenario.steps;
   timeStep_ = scenario.timeStep;
   const int n = scenario.agentCount();
-  states_.resize(static_cast<std::size_t>(n));
+  states_ = RecordLedger(n, kKeptSteps);
   const double splitMb = optionalParam(pnh, "split_size", 256.0);
   const double maxMb = optionalParam(pnh, "max_size", 1024.0);
   if (!(splitMb >= 0.0 && splitMb < 1e9)) throw InvalidInput("~split_size: must be in [0, 1e9) MB, got " + std::to_string(splitMb));
@@ -111,10 +102,7 @@ void RecorderNode::enforceLimits() {
     try {
       openPart();
     } catch (const std::exception& e) {
-      progress_.state = RunProgress::FAILED;
-      progress_.reason = e.what();
-      progressPub_.publish(progress_);
-      exitStatus_ = 1;
+      fail(e.what());
     }
   }
 }
@@ -127,12 +115,7 @@ void RecorderNode::write(const std::string& topic, const M& msg, const ros::Time
     ++written_;
     enforceLimits();
   } catch (const std::exception& e) {
-    progress_.state = RunProgress::FAILED;
-    progress_.reason = std::string("cannot write ") + path_ + ": " + e.what();
-    progressPub_.publish(progress_);
-    ROS_ERROR("recorder: %s", progress_.reason.c_str());
-    close("failed");
-    exitStatus_ = 1;
+    fail(std::string("cannot write ") + path_ + ": " + e.what());
   }
 }
 
@@ -159,10 +142,10 @@ void RecorderNode::catchUp() {
   if (secondsSince(stalledSince_) < 1.0) return;
   std::vector<std::string> services;
   std::vector<int> agents;
-  for (std::size_t i = 0; i < states_.size(); ++i) {
-    if (states_[i].next <= progress_.completed_step + 1) {
-      agents.push_back(static_cast<int>(i));
-      services.push_back(owners_[i] + "/history");
+  for (int i = 0; i < states_.agentCount(); ++i) {
+    if (states_.statesBelow(i) <= progress_.completed_step + 1) {
+      agents.push_back(i);
+      services.push_back(owners_[static_cast<std::size_t>(i)] + "/history");
     }
   }
   // Ask the agents, and the monitor, which keeps what it accepted until this recorder confirms
@@ -178,18 +161,32 @@ void RecorderNode::catchUp() {
     if (!answered[c]) continue;
     const int agent = agents[c % agents.size()];
     for (const AgentState& s : calls[c].response.states) {
-      if (!states_[static_cast<std::size_t>(agent)].holds(s.step)) record(agent, s);
+      if (!states_.holdsState(agent, s.step)) record(agent, s);
     }
   }
   stalledSince_ = ros::WallTime::now();
 }
 
 void RecorderNode::record(int agent, const AgentState& msg) {
-  write(nh_.resolveName("agent_" + std::to_string(agent) + "/state"), msg, msg.header.stamp);
-  if (!states_[static_cast<std::size_t>(agent)].add(msg.step)) {
-    ++repeats_;  // a repeat is written as received; it must equal the first (doc/distributed.md)
+  RecordLedger::Arrival arrival = RecordLedger::Arrival::New;
+  try {
+    arrival = states_.addState(agent, msg.step, msg.position, msg.previous_position);
+  } catch (const InvalidInput& e) {
+    ++dropped_;
+    ROS_WARN_THROTTLE(1.0, "recorder: dropped a state of agent_%d: %s; %ld dropped so far", agent, e.what(), dropped_);
     return;
   }
+  if (arrival == RecordLedger::Arrival::Differs) {
+    fail("agent_" + std::to_string(agent) + "'s step " + std::to_string(msg.step) +
+         " arrived twice with different positions: a recovery did not reproduce it bit for bit");
+    return;
+  }
+  if (arrival != RecordLedger::Arrival::New) {
+    ++repeats_;  // already written (doc/distributed.md, recording)
+    uncompared_ += arrival == RecordLedger::Arrival::Unchecked;
+    return;
+  }
+  write(nh_.resolveName("agent_" + std::to_string(agent) + "/state"), msg, msg.header.stamp);
   tf2_msgs::TFMessage tf;
   tf.transforms.resize(1);
   auto& t = tf.transforms[0];
@@ -206,15 +203,15 @@ void RecorderNode::record(int agent, const AgentState& msg) {
 void RecorderNode::onStatus(const ros::MessageEvent<FormationStatus const>& event) {
   if (!fromOwner(event, monitor_)) return;
   const FormationStatus& msg = *event.getConstMessage();
+  if (msg.step < 0 || !status_.add(msg.step)) return;  // a republished status is written once
   write(nh_.resolveName("status"), msg, msg.header.stamp);
-  if (status_.add(msg.step)) report();
+  report();
 }
 
 void RecorderNode::onMarkers(const ros::MessageEvent<visualization_msgs::MarkerArray const>& event) {
   if (!fromOwner(event, monitor_)) return;
   const auto& msg = *event.getConstMessage();
   const ros::Time stamp = msg.markers.empty() ? ros::TIME_MIN : msg.markers[0].header.stamp;
-  write(nh_.resolveName("markers"), msg, stamp);
   const long step = std::lround(stamp.toSec() / timeStep_);
   bool added = false;
   if (step % markerEvery_ == 0) {
@@ -222,7 +219,9 @@ void RecorderNode::onMarkers(const ros::MessageEvent<visualization_msgs::MarkerA
   } else if (steps_ > 0 && step == steps_ && !lastMarker_) {
     added = lastMarker_ = true;
   }
-  if (added) report();
+  if (!added) return;  // a republished step's markers are written once
+  write(nh_.resolveName("markers"), msg, stamp);
+  report();
 }
 
 // The monitor publishes the markers of every marker_every-th step and of the last one.
@@ -245,7 +244,7 @@ void RecorderNode::report() {
   if (progress_.state == RunProgress::FAILED || progress_.state == RunProgress::FINISHED) return;
   // Complete up to k: every agent's states, the status and the markers up to k.
   long complete = std::min(status_.next - 1, markersThrough());
-  for (const Steps& s : states_) complete = std::min(complete, s.next - 1);
+  for (int i = 0; i < states_.agentCount(); ++i) complete = std::min(complete, states_.statesBelow(i) - 1);
   if (complete <= progress_.completed_step) return;
   progress_.completed_step = complete;
   progress_.header.stamp.fromSec(static_cast<double>(complete) * timeStep_);
@@ -257,12 +256,22 @@ void RecorderNode::report() {
   progressPub_.publish(progress_);
 }
 
+void RecorderNode::fail(const std::string& reason) {
+  progress_.state = RunProgress::FAILED;
+  progress_.reason = reason;
+  progressPub_.publish(progress_);
+  ROS_ERROR("recorder: %s", reason.c_str());
+  close("failed");
+  exitStatus_ = 1;
+}
+
 void RecorderNode::close(const std::string& how) {
   if (!open_) return;
   open_ = false;
   bag_.close();
-  ROS_INFO("recorder: %s closed (%s): %ld messages, %ld repeated states, %ld dropped", path_.c_str(), how.c_str(),
-           written_, repeats_, dropped_);
+  ROS_INFO("recorder: %s closed (%s): %ld messages, %ld repeated states not written again (%ld equal to the "
+           "written copy bit for bit, %ld too old to compare), %ld dropped", path_.c_str(), how.c_str(), written_,
+           repeats_, repeats_ - uncompared_, uncompared_, dropped_);
 }
 
 int RecorderNode::run() {

@@ -159,18 +159,24 @@ class FaultRun(unittest.TestCase, vf_rostest.RunChecks):
             return
         self.assertEqual(self.result.get("result"), "succeeded", f"result file: {self.result}")
         rec = vf_rostest.Recording(os.path.join(self.out, self.name + ".bag"))
-        self.check_recording_with_repeats(rec)
+        self.check_recording_once(rec)
         if self.fault == "kill_monitor":
             self.check_status_after_monitor_restart(rec)
 
-    def check_recording_with_repeats(self, rec):
+    def check_recording_once(self, rec):
+        # Every state and status exactly once, whatever the fault made arrive twice: the recorder
+        # writes the first copy and fails the run (checked above) if a repeat differs from it.
         n, steps = self.scenario["n"], int(self.scenario["steps"])
         missing = [(i, k) for i in range(n) for k in range(steps + 1) if (i, k) not in rec.states]
         self.assertEqual(missing[:10], [], f"{len(missing)} agent states missing")
+        twice = sorted(key for key, msgs in rec.states.items() if len(msgs) != 1)
+        self.assertEqual(twice[:10], [], f"{len(twice)} states recorded more than once")
+        self.assertEqual(len(rec.states), n * (steps + 1), "states beyond the last step")
         mismatches = sum(list(m.position) != self.expected[key] or list(m.previous_position) != (
             self.expected[(key[0], max(key[1] - 1, 0))]) for key, msgs in rec.states.items() for m in msgs)
-        self.assertEqual(mismatches, 0, "recorded states differ from simulate (a repeat differed?)")
-        self.assertEqual(sorted(set(rec.status)), list(range(steps + 1)), "status of every step")
+        self.assertEqual(mismatches, 0, "recorded states differ from simulate")
+        self.assertEqual(sorted(rec.status), list(range(steps + 1)), "status of every step")
+        self.assertEqual([k for k, msgs in rec.status.items() if len(msgs) != 1], [], "statuses recorded twice")
         self.check_noether(rec)
 
     def check_noether(self, rec):
@@ -184,7 +190,7 @@ class FaultRun(unittest.TestCase, vf_rostest.RunChecks):
 
     def check_status_after_monitor_restart(self, rec):
         # Congruence computed here from simulate's trajectory (all pairs within 1%, speeds < 0.1),
-        # against every status, repeats included: the restarted monitor carries the stretch on.
+        # against every recorded status: the restarted monitor carries the stretch on.
         n, h = self.scenario["n"], float(self.scenario["time_step"])
         desired = [a["desired_position"] for a in self.scenario["agents"]]
         since = -1

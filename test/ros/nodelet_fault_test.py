@@ -2,7 +2,7 @@
 """rostest (nodelet_fault.test): SIGKILL to the nodelet manager that hosts every agent, during a
 recorded run (formation.launch nodelet:=true). All agents die at once; the manager respawns and
 loads every agent again, and every agent recovers from the monitor. The run must end by itself as succeeded, with every (agent, step)
-state recorded and equal to simulate bit for bit (repeats identical), as for fault.test.
+state recorded once and equal to simulate bit for bit, as for fault.test.
 Prints the recovery time: from the kill until the monitor completes a step it had not before.
 """
 import os

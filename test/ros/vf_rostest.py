@@ -76,7 +76,7 @@ class Recording:
 
     def __init__(self, bag_path, ns="/formation"):
         self.states, self.status, self.tf, self.topics = {}, {}, {}, set()
-        self.marker_stamps = []  # one per marker array (a republished one repeats its stamp)
+        self.marker_stamps = []  # one per marker array
         self.bag_times = []
         # A long run is split into <name>.bag, <name>_1.bag, ... (record_split_size): read them all.
         parts, stem = [bag_path], bag_path[:-len(".bag")] if bag_path.endswith(".bag") else bag_path
@@ -103,9 +103,12 @@ class RunChecks:
 
     def check_recording(self, rec, scenario, expected, ns="/formation"):
         n, steps, h = scenario["n"], int(scenario["steps"]), float(scenario["time_step"])
-        # Every (agent, step) is there; a repeat (none expected here) would have to be identical.
+        # Every (agent, step) is there, once: the recorder writes a repeat never.
         missing = [(i, k) for i in range(n) for k in range(steps + 1) if (i, k) not in rec.states]
         self.assertEqual(missing[:10], [], f"{len(missing)} agent states missing")
+        twice = sorted(key for key, msgs in rec.states.items() if len(msgs) != 1)
+        self.assertEqual(twice[:10], [], f"{len(twice)} states recorded more than once")
+        self.assertEqual([k for k, msgs in rec.status.items() if len(msgs) != 1], [], "statuses recorded twice")
         self.assertEqual(len(rec.states), n * (steps + 1), "states beyond the last step")
         mismatches = 0
         for (i, k), msgs in rec.states.items():
@@ -117,8 +120,8 @@ class RunChecks:
                 self.assertAlmostEqual(m.time, k * h, delta=1e-12 * (1 + k * h))
         self.assertEqual(mismatches, 0, f"{mismatches} recorded positions differ from simulate")
         self.assertEqual(sorted(rec.status), list(range(steps + 1)), "status of every step once")
-        # Markers of every step (the monitor republishes those the recorder has not confirmed).
-        self.assertEqual(sorted({round(t / h) for t in rec.marker_stamps}), list(range(steps + 1)))
+        # Markers of every step, once (the monitor republishes those the recorder has not confirmed).
+        self.assertEqual(sorted(round(t / h) for t in rec.marker_stamps), list(range(steps + 1)))
         # tf: every agent's frame, prefixed by the namespace, at every step, stamped t_k.
         prefix = ns.lstrip("/") + "/" if ns.strip("/") else ""
         for i in range(n):

@@ -1,6 +1,5 @@
 #pragma once
 
-#include <set>
 #include <string>
 #include <vector>
 
@@ -12,6 +11,7 @@
 #include "variational_formation/FormationStatus.h"
 #include "variational_formation/RecallHistory.h"
 #include "variational_formation/RunProgress.h"
+#include "variational_formation/core/record_ledger.hpp"
 #include "variational_formation/core/scenario.hpp"
 
 namespace vf {
@@ -36,6 +36,11 @@ using variational_formation::RunProgress;
  * together reach it; the run goes on and the recorder keeps counting steps, so it never holds
  * the agents back afterwards.
  *
+ * The bag holds each (agent, step) state, each status and each step's markers once: a copy that
+ * arrives again (from a history fetched while the topic was still delivering it, or from an
+ * agent that republishes after a restart) is not written, and a repeated state that differs
+ * from the written one, bit for bit, fails the run (RecordLedger).
+ *
  * Private parameters: ~scenario, ~bag (both required), ~monitor (default "monitor"),
  * ~split_size, ~max_size.
  */
@@ -46,14 +51,6 @@ class RecorderNode {
   int run();
 
  private:
-  /// Steps of one stream written so far: all below `next`, and some beyond it.
-  struct Steps {
-    long next = 0;
-    std::set<long> ahead;
-    /// @return true if the step is new.
-    bool add(long step);
-    bool holds(long step) const;
-  };
   template <typename M>
   void write(const std::string& topic, const M& msg, const ros::Time& stamp);
   void onState(int agent, const ros::MessageEvent<AgentState const>& event);
@@ -64,6 +61,8 @@ class RecorderNode {
   void onMonitorProgress(const ros::MessageEvent<RunProgress const>& event);
   void report();
   void close(const std::string& how);
+  /// Ends the recording and tells the monitor, which ends the run as failed, naming the reason.
+  void fail(const std::string& reason);
   void openPart();
   void enforceLimits();
 
@@ -77,13 +76,13 @@ class RecorderNode {
   double timeStep_ = 0.0;
   std::vector<std::string> owners_;
   std::vector<std::string> managers_;  // ~agent_manager: nodelet managers of agents
-  std::vector<Steps> states_;
-  Steps status_;
-  Steps markers_;  // markers by k / marker_every, for the steps t_k that are multiples of it
+  RecordLedger states_;  // each state is written once; repeats are compared with it
+  StepSet status_;
+  StepSet markers_;  // markers by k / marker_every, for the steps t_k that are multiples of it
   long markerEvery_ = 1;
   bool lastMarker_ = false;  // the last step's markers, when it is not a multiple
   long markersThrough() const;
-  long written_ = 0, repeats_ = 0, dropped_ = 0;
+  long written_ = 0, repeats_ = 0, uncompared_ = 0, dropped_ = 0;
   bool open_ = false;
   ros::WallTimer catchUpTimer_;
   ros::WallTime stalledSince_;
