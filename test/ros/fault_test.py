@@ -34,6 +34,10 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import vf_rostest  # noqa: E402
 
 NS = "/formation"
+# formation.launch's default window: agents run up to this many steps ahead of the last step the
+# watch has seen complete, so a killed agent has new steps to publish only if it is killed at
+# least this far from the end.
+WINDOW = 100
 
 
 
@@ -98,14 +102,14 @@ class FaultRun(unittest.TestCase, vf_rostest.RunChecks):
         if cls.fault in ("kill_agent", "kill_agent_twice", "stop_agent"):
             victim = rng.randrange(n)
             count = 2 if cls.fault == "kill_agent_twice" else cls.kills
-            at = sorted(rng.sample(range(20, steps - 40), count))
+            at = sorted(rng.sample(range(20, steps - WINDOW - 40), count))
             # Kills one after another: each waits until the previous one has recovered.
             for step in at:
                 cls.inject(step, [victim], signal.SIGSTOP if cls.fault == "stop_agent" else signal.SIGKILL)
         elif cls.fault == "kill_two":
             first = rng.choice([i for i in range(n) if len(cls.scenario["neighbours"][i]) < n - 1])
             others = [j for j in range(n) if j != first and j not in cls.scenario["neighbours"][first]]
-            cls.inject(rng.randrange(20, steps - 40), [first, rng.choice(others)], signal.SIGKILL)
+            cls.inject(rng.randrange(20, steps - WINDOW - 40), [first, rng.choice(others)], signal.SIGKILL)
         elif cls.fault == "kill_monitor":
             cls.inject(rng.randrange(20, steps - 40), ["monitor"], signal.SIGKILL)
         elif cls.fault == "kill_recorder":
@@ -132,7 +136,8 @@ class FaultRun(unittest.TestCase, vf_rostest.RunChecks):
                 os.kill(pid, signal.SIGCONT)
         for v, last in before.items():
             seconds = cls.watch.wait_for_agent_beyond(v, last)
-            assert seconds is not None, f"agent_{v} never published a new step after the fault"
+            assert seconds is not None, (f"agent_{v} never published a step after {last} after the fault at step "
+                                         f"{step} (the newest complete step seen is {cls.watch.step})")
             if sig == signal.SIGKILL:
                 cls.recoveries.append(seconds)
         if cls.fault == "kill_monitor":
