@@ -121,7 +121,9 @@ class FaultRun(unittest.TestCase, vf_rostest.RunChecks):
 
     @classmethod
     def inject(cls, step, victims, sig):
-        assert cls.watch.wait_for_step(step), f"the run never reached step {step}"
+        assert cls.watch.wait_for_step(step), (
+            f"the run never reached step {step}: the newest complete step seen is {cls.watch.step}, "
+            f"the result file says {vf_rostest.wait_for_result(os.path.join(cls.out, cls.name + '.result.yaml'), 0.0)}")
         names = [f"{NS}/agent_{v}" if isinstance(v, int) else f"{NS}/{v}" for v in victims]
         pids = [vf_rostest.node_pid(name) for name in names]
         before = {v: cls.watch.newest[v][0] for v in victims if isinstance(v, int)}

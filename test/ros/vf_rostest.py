@@ -57,9 +57,10 @@ def node_pid(name, timeout=20.0):
 
 
 def wait_for_result(path, timeout):
-    """The monitor's result file once the run is over ({} if it is not within `timeout`)."""
+    """The monitor's result file once the run is over ({} if it is not within `timeout`; read
+    once with timeout 0)."""
     end = time.time() + timeout
-    while time.time() < end:
+    while True:
         try:
             with open(path) as f:
                 result = yaml.safe_load(f) or {}
@@ -67,8 +68,9 @@ def wait_for_result(path, timeout):
                 return result
         except OSError:
             pass
+        if time.time() >= end:
+            return {}
         time.sleep(0.2)
-    return {}
 
 
 class Recording:
