@@ -2,7 +2,8 @@
 # Where the time of a nodelet run goes: one ring formation (make_scenario) per agent count, all
 # agents in formation/manager, run as fast as possible on its own ROS master (a free port in
 # 11600-11649; 800000 / n steps, about 20-30 s). While it runs, `perf record` samples the manager and the monitor for
-# VF_PROFILE_SECONDS (default 5) s, and the script prints for each:
+# VF_PROFILE_SECONDS (default 5) s (and the recorder, with record:=true), and the script prints
+# for each:
 #   - its share of the machine's CPU over that window (100 = one core), from /proc;
 #   - perf's split of its samples by library: kernel, roscpp (roscpp, serialisation, xmlrpc,
 #     rosconsole, cpp_common), libc/libstdc++ (locks, allocation), tf2, the package's ROS layer,
@@ -38,7 +39,8 @@ split_by_library() {
       else if (d ~ /^libc\.|libstdc|libpthread|libm\./) k = "libc/libstdc++"
       else if (d ~ /tf2/) k = "tf2"
       else if (d ~ /variational_formation_core/) k = "core (maths)"
-      else if (d ~ /variational_formation|agent_manager|^monitor$/) k = "ROS layer"
+      else if (d ~ /rosbag|roslz4|bz2|lz4/) k = "rosbag"
+      else if (d ~ /variational_formation|agent_manager|^monitor$|^recorder$/) k = "ROS layer"
       else k = "other"
       share[k] += p
     }
@@ -65,34 +67,42 @@ for n in "${counts[@]}"; do
   done
   awk -v s="$started" -v e="$EPOCHREALTIME" -v n="$n" 'BEGIN { printf "profile_ros: %s agents: running %.1f s after the launch\n", n, e - s }'
   sleep 1
-  manager=$(pgrep -f "agent_manager __name:=manager" | head -n 1 || true)
-  monitor=$(pgrep -f "/monitor __name:=monitor" | head -n 1 || true)
-  if [ -z "$manager" ] || [ -z "$monitor" ]; then
+  # The manager and the monitor, and the recorder with record:=true.
+  names=() pids=()
+  for spec in "manager:agent_manager __name:=manager" "monitor:/monitor __name:=monitor" \
+              "recorder:/recorder __name:=recorder"; do
+    pid=$(pgrep -f "${spec#*:}" | head -n 1 || true)
+    if [ -n "$pid" ]; then names+=("${spec%%:*}"); pids+=("$pid"); fi
+  done
+  if [ "${names[0]:-}" != manager ] || [ "${names[1]:-}" != monitor ]; then
     echo "profile_ros: $n agents: the manager or the monitor is not running; see the launch output:" >&2
     tail -n 20 "$log" >&2
     kill -INT "$launch" 2>/dev/null; wait "$launch"
     exit 1
   fi
-  m0=$(ticks "$manager") o0=$(ticks "$monitor") t0=$EPOCHREALTIME
+  before=() t0=$EPOCHREALTIME
+  for pid in "${pids[@]}"; do before+=("$(ticks "$pid")"); done
   if command -v perf >/dev/null; then
-    perf record -q -F 499 -g -p "$manager" -o "$tmp/manager.data" -- sleep "$seconds" >/dev/null 2>&1 &
-    perf record -q -F 499 -g -p "$monitor" -o "$tmp/monitor.data" -- sleep "$seconds" >/dev/null 2>&1
-    wait %2 2>/dev/null || true
+    for k in "${!pids[@]}"; do
+      perf record -q -F 499 -g -p "${pids[$k]}" -o "$tmp/${names[$k]}.data" -- sleep "$seconds" >/dev/null 2>&1 &
+    done
+    wait $(jobs -p | grep -v "^$launch$") 2>/dev/null || true
   else
     sleep "$seconds"
   fi
-  m1=$(ticks "$manager") o1=$(ticks "$monitor") t1=$EPOCHREALTIME
+  cpu="" t1=$EPOCHREALTIME
+  for k in "${!pids[@]}"; do
+    cpu+=$(awk -v a="${before[$k]}" -v b="$(ticks "${pids[$k]}")" -v s="$t0" -v e="$t1" -v hz="$hz" -v name="${names[$k]}" \
+      'BEGIN { printf "%s%s %.0f", (name == "manager" ? "" : ", "), name, 100 * (b - a) / hz / (e - s) }')
+  done
   wait "$launch" 2>/dev/null
   rate=$(sed -E 's/\x1b\[[0-9;]*m//g' "$log" | grep -oE '[0-9]+ steps/s' | tail -n 1)
   echo "== $n agents (ring with chords, nodelet:=true ${extra[*]}): ${rate:-no final line} over the run, ${seconds} s sampled"
-  awk -v a="$m0" -v b="$m1" -v c="$o0" -v d="$o1" -v s="$t0" -v e="$t1" -v hz="$hz" 'BEGIN {
-    w = e - s
-    printf "  CPU (100 = one core): manager %.0f, monitor %.0f\n", 100 * (b - a) / hz / w, 100 * (d - c) / hz / w }'
-  if [ -f "$tmp/manager.data" ]; then
-    echo "  manager (all $n agents), samples by library:"
-    split_by_library "$tmp/manager.data"
-    echo "  monitor, samples by library:"
-    split_by_library "$tmp/monitor.data"
-  fi
-  rm -f "$tmp/manager.data" "$tmp/monitor.data"
+  echo "  CPU (100 = one core): $cpu"
+  for name in "${names[@]}"; do
+    [ -f "$tmp/$name.data" ] || continue
+    echo "  $name$([ "$name" = manager ] && echo " (all $n agents)"), samples by library:"
+    split_by_library "$tmp/$name.data"
+    rm -f "$tmp/$name.data"
+  done
 done

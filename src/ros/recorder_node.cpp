@@ -43,8 +43,11 @@ RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh),
   openPart();
   const std::string ns = framePrefix(nh);
   framePrefix_ = ns;
+  statusTopic_ = nh.resolveName("status");
+  markersTopic_ = nh.resolveName("markers");
   for (int i = 0; i < n; ++i) {
     owners_.push_back(agentNodeName(nh, i));
+    stateTopics_.push_back(nh.resolveName("agent_" + std::to_string(i) + "/state"));
     subs_.push_back(nh.subscribe<AgentState>(
         "agent_" + std::to_string(i) + "/state", kQueue,
         boost::function<void(const ros::MessageEvent<AgentState const>&)>(
@@ -120,8 +123,8 @@ void RecorderNode::write(const std::string& topic, const M& msg, const ros::Time
 }
 
 void RecorderNode::onState(int agent, const ros::MessageEvent<AgentState const>& event) {
-  const AgentState& msg = *event.getConstMessage();
-  if (!fromAgent(event, owners_[static_cast<std::size_t>(agent)], managers_) || static_cast<int>(msg.id) != agent) {
+  const AgentState::ConstPtr msg = event.getConstMessage();
+  if (!fromAgent(event, owners_[static_cast<std::size_t>(agent)], managers_) || static_cast<int>(msg->id) != agent) {
     ++dropped_;
     ROS_WARN_THROTTLE(1.0, "recorder: dropped a state on agent_%d's topic from %s; %ld dropped so far", agent,
                       event.getPublisherName().c_str(), dropped_);
@@ -161,74 +164,103 @@ void RecorderNode::catchUp() {
     if (!answered[c]) continue;
     const int agent = agents[c % agents.size()];
     for (const AgentState& s : calls[c].response.states) {
-      if (!states_.holdsState(agent, s.step)) record(agent, s);
+      if (!states_.holdsState(agent, s.step)) record(agent, boost::make_shared<AgentState>(s));
     }
   }
   stalledSince_ = ros::WallTime::now();
 }
 
-void RecorderNode::record(int agent, const AgentState& msg) {
+void RecorderNode::record(int agent, const AgentState::ConstPtr& msg) {
   RecordLedger::Arrival arrival = RecordLedger::Arrival::New;
   try {
-    arrival = states_.addState(agent, msg.step, msg.position, msg.previous_position);
+    arrival = states_.addState(agent, msg->step, msg->position, msg->previous_position);
   } catch (const InvalidInput& e) {
     ++dropped_;
     ROS_WARN_THROTTLE(1.0, "recorder: dropped a state of agent_%d: %s; %ld dropped so far", agent, e.what(), dropped_);
     return;
   }
   if (arrival == RecordLedger::Arrival::Differs) {
-    fail("agent_" + std::to_string(agent) + "'s step " + std::to_string(msg.step) +
+    fail("agent_" + std::to_string(agent) + "'s step " + std::to_string(msg->step) +
          " arrived twice with different positions: a recovery did not reproduce it bit for bit");
     return;
   }
   if (arrival != RecordLedger::Arrival::New) {
-    ++repeats_;  // already written (doc/distributed.md, recording)
+    ++repeats_;  // already held (doc/distributed.md, recording)
     uncompared_ += arrival == RecordLedger::Arrival::Unchecked;
     return;
   }
-  write(nh_.resolveName("agent_" + std::to_string(agent) + "/state"), msg, msg.header.stamp);
-  tf2_msgs::TFMessage tf;
-  tf.transforms.resize(1);
-  auto& t = tf.transforms[0];
-  t.header = msg.header;
-  t.child_frame_id = framePrefix_ + "agent_" + std::to_string(agent);
-  t.transform.translation.x = msg.position.size() > 0 ? msg.position[0] : 0.0;
-  t.transform.translation.y = msg.position.size() > 1 ? msg.position[1] : 0.0;
-  t.transform.translation.z = msg.position.size() > 2 ? msg.position[2] : 0.0;
-  t.transform.rotation.w = 1.0;
-  write("/tf", tf, msg.header.stamp);
+  if (msg->step <= writtenThrough_) return;  // cannot happen: a written step had all its states
+  Pending& p = pendingAt(msg->step);
+  p.states[static_cast<std::size_t>(agent)] = msg;
+  ++p.stateCount;
+  flush();
+}
+
+RecorderNode::Pending& RecorderNode::pendingAt(long step) {
+  auto it = pending_.find(step);
+  if (it == pending_.end()) {
+    it = pending_.emplace(step, Pending()).first;
+    it->second.states.resize(static_cast<std::size_t>(states_.agentCount()));
+  }
+  return it->second;
+}
+
+bool RecorderNode::needsMarkers(long step) const {
+  return step % markerEvery_ == 0 || (steps_ > 0 && step == steps_);
+}
+
+void RecorderNode::flush() {
+  // Steps are written whole and in order, so the bag's messages are in time order: readers that
+  // trust it (Python's rosbag merges chunks assuming it) see every stream in step order.
+  while (!pending_.empty() && pending_.begin()->first == writtenThrough_ + 1) {
+    const long step = pending_.begin()->first;
+    Pending& p = pending_.begin()->second;
+    if (p.stateCount < states_.agentCount() || !p.status || (needsMarkers(step) && !p.markers)) break;
+    for (std::size_t i = 0; i < p.states.size(); ++i) {
+      const AgentState& msg = *p.states[i];
+      write(stateTopics_[i], msg, msg.header.stamp);
+      tf2_msgs::TFMessage tf;
+      tf.transforms.resize(1);
+      auto& t = tf.transforms[0];
+      t.header = msg.header;
+      t.child_frame_id = framePrefix_ + "agent_" + std::to_string(i);
+      t.transform.translation.x = msg.position.size() > 0 ? msg.position[0] : 0.0;
+      t.transform.translation.y = msg.position.size() > 1 ? msg.position[1] : 0.0;
+      t.transform.translation.z = msg.position.size() > 2 ? msg.position[2] : 0.0;
+      t.transform.rotation.w = 1.0;
+      write("/tf", tf, msg.header.stamp);
+    }
+    write(statusTopic_, *p.status, p.status->header.stamp);
+    if (p.markers) write(markersTopic_, *p.markers, markersStamp(*p.markers));
+    pending_.erase(pending_.begin());
+    writtenThrough_ = step;
+  }
   report();
 }
 
 void RecorderNode::onStatus(const ros::MessageEvent<FormationStatus const>& event) {
   if (!fromOwner(event, monitor_)) return;
-  const FormationStatus& msg = *event.getConstMessage();
-  if (msg.step < 0 || !status_.add(msg.step)) return;  // a republished status is written once
-  write(nh_.resolveName("status"), msg, msg.header.stamp);
-  report();
+  const FormationStatus::ConstPtr msg = event.getConstMessage();
+  if (msg->step <= writtenThrough_) return;  // republished: written once
+  Pending& p = pendingAt(msg->step);
+  if (p.status) return;
+  p.status = msg;
+  flush();
+}
+
+ros::Time RecorderNode::markersStamp(const visualization_msgs::MarkerArray& msg) {
+  return msg.markers.empty() ? ros::TIME_MIN : msg.markers[0].header.stamp;
 }
 
 void RecorderNode::onMarkers(const ros::MessageEvent<visualization_msgs::MarkerArray const>& event) {
   if (!fromOwner(event, monitor_)) return;
-  const auto& msg = *event.getConstMessage();
-  const ros::Time stamp = msg.markers.empty() ? ros::TIME_MIN : msg.markers[0].header.stamp;
-  const long step = std::lround(stamp.toSec() / timeStep_);
-  bool added = false;
-  if (step % markerEvery_ == 0) {
-    added = markers_.add(step / markerEvery_);
-  } else if (steps_ > 0 && step == steps_ && !lastMarker_) {
-    added = lastMarker_ = true;
-  }
-  if (!added) return;  // a republished step's markers are written once
-  write(nh_.resolveName("markers"), msg, stamp);
-  report();
-}
-
-// The monitor publishes the markers of every marker_every-th step and of the last one.
-long RecorderNode::markersThrough() const {
-  const long through = markers_.next * markerEvery_ - 1;
-  if (steps_ <= 0 || through < steps_ || steps_ % markerEvery_ == 0 || lastMarker_) return through;
-  return steps_ - 1;
+  const auto msg = event.getConstMessage();
+  const long step = std::lround(markersStamp(*msg).toSec() / timeStep_);
+  if (step <= writtenThrough_ || !needsMarkers(step)) return;  // republished: written once
+  Pending& p = pendingAt(step);
+  if (p.markers) return;
+  p.markers = msg;
+  flush();
 }
 
 void RecorderNode::onMonitorProgress(const ros::MessageEvent<RunProgress const>& event) {
@@ -242,9 +274,8 @@ void RecorderNode::onMonitorProgress(const ros::MessageEvent<RunProgress const>&
 
 void RecorderNode::report() {
   if (progress_.state == RunProgress::FAILED || progress_.state == RunProgress::FINISHED) return;
-  // Complete up to k: every agent's states, the status and the markers up to k.
-  long complete = std::min(status_.next - 1, markersThrough());
-  for (int i = 0; i < states_.agentCount(); ++i) complete = std::min(complete, states_.statesBelow(i) - 1);
+  // Complete up to k: every agent's state, the status and the markers of steps 0..k are written.
+  const long complete = writtenThrough_;
   if (complete <= progress_.completed_step) return;
   progress_.completed_step = complete;
   progress_.header.stamp.fromSec(static_cast<double>(complete) * timeStep_);

@@ -173,12 +173,15 @@ class FaultRun(unittest.TestCase, vf_rostest.RunChecks):
     def check_recording_once(self, rec):
         # Every state and status exactly once, whatever the fault made arrive twice: the recorder
         # writes the first copy and fails the run (checked above) if a repeat differs from it.
+        # Whole steps in order, whatever the fault made arrive late.
         n, steps = self.scenario["n"], int(self.scenario["steps"])
         missing = [(i, k) for i in range(n) for k in range(steps + 1) if (i, k) not in rec.states]
         self.assertEqual(missing[:10], [], f"{len(missing)} agent states missing")
         twice = sorted(key for key, msgs in rec.states.items() if len(msgs) != 1)
         self.assertEqual(twice[:10], [], f"{len(twice)} states recorded more than once")
         self.assertEqual(len(rec.states), n * (steps + 1), "states beyond the last step")
+        # States that came late (a history fetched after a kill) are still written in step order.
+        self.assertEqual(rec.out_of_order[:5], [], f"{len(rec.out_of_order)} messages out of time order")
         mismatches = sum(list(m.position) != self.expected[key] or list(m.previous_position) != (
             self.expected[(key[0], max(key[1] - 1, 0))]) for key, msgs in rec.states.items() for m in msgs)
         self.assertEqual(mismatches, 0, "recorded states differ from simulate")

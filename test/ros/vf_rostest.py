@@ -77,9 +77,13 @@ class Recording:
     """Everything a bag of formation.launch record:=true holds, by agent and step."""
 
     def __init__(self, bag_path, ns="/formation"):
-        self.states, self.status, self.tf, self.topics = {}, {}, {}, set()
+        self.states, self.status, self.tf, self.tf_times, self.topics = {}, {}, {}, {}, set()
         self.marker_stamps = []  # one per marker array
         self.bag_times = []
+        # Messages whose bag time is earlier than the one before (Python's rosbag yields them in
+        # write order across chunks, so a late write shows up here).
+        self.out_of_order = []
+        last = None
         # A long run is split into <name>.bag, <name>_1.bag, ... (record_split_size): read them all.
         parts, stem = [bag_path], bag_path[:-len(".bag")] if bag_path.endswith(".bag") else bag_path
         while os.path.exists(f"{stem}_{len(parts)}.bag"):
@@ -87,6 +91,9 @@ class Recording:
         for part in parts:
             with rosbag.Bag(part) as bag:
                 for topic, msg, t in bag.read_messages():
+                    if last is not None and t < last:
+                        self.out_of_order.append((topic, t.to_sec(), last.to_sec()))
+                    last = t
                     self.topics.add(topic)
                     if topic.startswith(ns + "/agent_") and topic.endswith("/state"):
                         self.states.setdefault((msg.id, msg.step), []).append(msg)
@@ -98,6 +105,7 @@ class Recording:
                     elif topic == "/tf":
                         for x in msg.transforms:
                             self.tf.setdefault(x.child_frame_id, []).append(x)
+                            self.tf_times.setdefault(x.child_frame_id, []).append(t.to_sec())
 
 
 class RunChecks:
@@ -111,6 +119,8 @@ class RunChecks:
         twice = sorted(key for key, msgs in rec.states.items() if len(msgs) != 1)
         self.assertEqual(twice[:10], [], f"{len(twice)} states recorded more than once")
         self.assertEqual([k for k, msgs in rec.status.items() if len(msgs) != 1], [], "statuses recorded twice")
+        # The recorder writes whole steps in order: the bag is in time order.
+        self.assertEqual(rec.out_of_order[:5], [], f"{len(rec.out_of_order)} messages out of time order")
         self.assertEqual(len(rec.states), n * (steps + 1), "states beyond the last step")
         mismatches = 0
         for (i, k), msgs in rec.states.items():
@@ -131,7 +141,13 @@ class RunChecks:
             self.assertEqual(len(frames), steps + 1, f"tf of {prefix}agent_{i}")
             for k, t in enumerate(frames):
                 self.assertEqual(t.header.frame_id, "world")
-                self.assertEqual(t.transform.translation.x, expected[(i, k)][0])
+                if t.transform.translation.x != expected[(i, k)][0]:  # says where the frames went
+                    x = expected[(i, k)][0]
+                    self.fail(f"tf of agent {i}: frame {k} of the bag, stamped {t.header.stamp.to_sec()!r}, holds "
+                              f"the x of steps {[m for m in range(steps + 1) if expected[(i, m)][0] == t.transform.translation.x]}; "
+                              f"step {k}'s x is in frames "
+                              f"{[(j, f.header.stamp.to_sec()) for j, f in enumerate(frames) if f.transform.translation.x == x]}; "
+                              f"bag times of frames {max(k - 2, 0)}..{k + 2}: {rec.tf_times[t.child_frame_id][max(k - 2, 0):k + 3]}")
         self.check_noether(rec)
 
     def check_noether(self, rec):

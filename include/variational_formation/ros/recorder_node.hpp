@@ -1,5 +1,6 @@
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -36,7 +37,9 @@ using variational_formation::RunProgress;
  * together reach it; the run goes on and the recorder keeps counting steps, so it never holds
  * the agents back afterwards.
  *
- * The bag holds each (agent, step) state, each status and each step's markers once: a copy that
+ * Steps are written whole and in order (states with their transforms, status, markers), once all
+ * of step k has arrived and after step k - 1, so the bag is in time order however late a state
+ * came. The bag holds each (agent, step) state, each status and each step's markers once: a copy that
  * arrives again (from a history fetched while the topic was still delivering it, or from an
  * agent that republishes after a restart) is not written, and a repeated state that differs
  * from the written one, bit for bit, fails the run (RecordLedger).
@@ -54,7 +57,21 @@ class RecorderNode {
   template <typename M>
   void write(const std::string& topic, const M& msg, const ros::Time& stamp);
   void onState(int agent, const ros::MessageEvent<AgentState const>& event);
-  void record(int agent, const AgentState& msg);
+  /// A state from the owner's topic or a fetched history: held until its step is written.
+  void record(int agent, const AgentState::ConstPtr& msg);
+  /// What has arrived of a step not yet written.
+  struct Pending {
+    std::vector<AgentState::ConstPtr> states;  // by agent
+    int stateCount = 0;
+    FormationStatus::ConstPtr status;
+    visualization_msgs::MarkerArray::ConstPtr markers;
+  };
+  Pending& pendingAt(long step);
+  /// Writes every complete step after writtenThrough_, in order, then reports.
+  void flush();
+  /// The monitor publishes the markers of every marker_every-th step and of the last one.
+  bool needsMarkers(long step) const;
+  static ros::Time markersStamp(const visualization_msgs::MarkerArray& msg);
   void catchUp();
   void onStatus(const ros::MessageEvent<FormationStatus const>& event);
   void onMarkers(const ros::MessageEvent<visualization_msgs::MarkerArray const>& event);
@@ -68,7 +85,8 @@ class RecorderNode {
 
   ros::NodeHandle nh_;
   rosbag::Bag bag_;
-  std::string path_, monitor_, framePrefix_, stateTopicPrefix_;
+  std::string path_, monitor_, framePrefix_, statusTopic_, markersTopic_;
+  std::vector<std::string> stateTopics_;
   std::vector<ros::Subscriber> subs_;
   ros::Publisher progressPub_;
   RunProgress progress_;
@@ -76,12 +94,10 @@ class RecorderNode {
   double timeStep_ = 0.0;
   std::vector<std::string> owners_;
   std::vector<std::string> managers_;  // ~agent_manager: nodelet managers of agents
-  RecordLedger states_;  // each state is written once; repeats are compared with it
-  StepSet status_;
-  StepSet markers_;  // markers by k / marker_every, for the steps t_k that are multiples of it
+  RecordLedger states_;  // each state is held once; repeats are compared with it
+  std::map<long, Pending> pending_;  // at most the window of steps after writtenThrough_
+  long writtenThrough_ = -1;  // every stream of steps 0..this is in the bag (or past its size limit)
   long markerEvery_ = 1;
-  bool lastMarker_ = false;  // the last step's markers, when it is not a multiple
-  long markersThrough() const;
   long written_ = 0, repeats_ = 0, uncompared_ = 0, dropped_ = 0;
   bool open_ = false;
   ros::WallTimer catchUpTimer_;
