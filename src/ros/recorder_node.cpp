@@ -41,13 +41,13 @@ RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh),
   maxBytes_ = maxMb * 1e6;
   createParentDirectory(path_, "~bag");
   openPart();
-  const std::string ns = framePrefix(nh);
-  framePrefix_ = ns;
+  const std::string prefix = framePrefix(nh);
   statusTopic_ = nh.resolveName("status");
   markersTopic_ = nh.resolveName("markers");
   for (int i = 0; i < n; ++i) {
     owners_.push_back(agentNodeName(nh, i));
     stateTopics_.push_back(nh.resolveName("agent_" + std::to_string(i) + "/state"));
+    frameIds_.push_back(prefix + "agent_" + std::to_string(i));
     subs_.push_back(nh.subscribe<AgentState>(
         "agent_" + std::to_string(i) + "/state", kQueue,
         boost::function<void(const ros::MessageEvent<AgentState const>&)>(
@@ -223,7 +223,7 @@ void RecorderNode::flush() {
       tf.transforms.resize(1);
       auto& t = tf.transforms[0];
       t.header = msg.header;
-      t.child_frame_id = framePrefix_ + "agent_" + std::to_string(i);
+      t.child_frame_id = frameIds_[i];
       t.transform.translation.x = msg.position.size() > 0 ? msg.position[0] : 0.0;
       t.transform.translation.y = msg.position.size() > 1 ? msg.position[1] : 0.0;
       t.transform.translation.z = msg.position.size() > 2 ? msg.position[2] : 0.0;

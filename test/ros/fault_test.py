@@ -171,32 +171,13 @@ class FaultRun(unittest.TestCase, vf_rostest.RunChecks):
             self.check_status_after_monitor_restart(rec)
 
     def check_recording_once(self, rec):
-        # Every state and status exactly once, whatever the fault made arrive twice: the recorder
-        # writes the first copy and fails the run (checked above) if a repeat differs from it.
-        # Whole steps in order, whatever the fault made arrive late.
+        # A repeat that differs from the written copy fails the run (checked above).
         n, steps = self.scenario["n"], int(self.scenario["steps"])
-        missing = [(i, k) for i in range(n) for k in range(steps + 1) if (i, k) not in rec.states]
-        self.assertEqual(missing[:10], [], f"{len(missing)} agent states missing")
-        twice = sorted(key for key, msgs in rec.states.items() if len(msgs) != 1)
-        self.assertEqual(twice[:10], [], f"{len(twice)} states recorded more than once")
-        self.assertEqual(len(rec.states), n * (steps + 1), "states beyond the last step")
-        # States that came late (a history fetched after a kill) are still written in step order.
-        self.assertEqual(rec.out_of_order[:5], [], f"{len(rec.out_of_order)} messages out of time order")
+        self.check_each_step_once(rec, n, steps)
         mismatches = sum(list(m.position) != self.expected[key] or list(m.previous_position) != (
             self.expected[(key[0], max(key[1] - 1, 0))]) for key, msgs in rec.states.items() for m in msgs)
         self.assertEqual(mismatches, 0, "recorded states differ from simulate")
-        self.assertEqual(sorted(rec.status), list(range(steps + 1)), "status of every step")
-        self.assertEqual([k for k, msgs in rec.status.items() if len(msgs) != 1], [], "statuses recorded twice")
         self.check_noether(rec)
-
-    def check_noether(self, rec):
-        for k, msgs in rec.status.items():
-            for s in msgs:
-                for x, pred in ((s.linear_momentum, s.linear_momentum_predicted),
-                                (s.angular_momentum, s.angular_momentum_predicted)):
-                    scale = max(1.0, math.sqrt(pred.x ** 2 + pred.y ** 2 + pred.z ** 2))
-                    err = math.sqrt((x.x - pred.x) ** 2 + (x.y - pred.y) ** 2 + (x.z - pred.z) ** 2)
-                    self.assertLess(err / scale, 1e-9, f"step {k}")
 
     def check_status_after_monitor_restart(self, rec):
         # Congruence computed here from simulate's trajectory (all pairs within 1%, speeds < 0.1),

@@ -111,17 +111,22 @@ class Recording:
 class RunChecks:
     """Mix-in for unittest.TestCase: the checks of one recorded run."""
 
-    def check_recording(self, rec, scenario, expected, ns="/formation"):
-        n, steps, h = scenario["n"], int(scenario["steps"]), float(scenario["time_step"])
-        # Every (agent, step) is there, once: the recorder writes a repeat never.
+    def check_each_step_once(self, rec, n, steps):
+        """Every (agent, step) state and every status is there once, whatever arrived twice (the
+        recorder writes a repeat never), and the bag is in time order, whatever arrived late (the
+        recorder writes whole steps in order)."""
         missing = [(i, k) for i in range(n) for k in range(steps + 1) if (i, k) not in rec.states]
         self.assertEqual(missing[:10], [], f"{len(missing)} agent states missing")
         twice = sorted(key for key, msgs in rec.states.items() if len(msgs) != 1)
         self.assertEqual(twice[:10], [], f"{len(twice)} states recorded more than once")
-        self.assertEqual([k for k, msgs in rec.status.items() if len(msgs) != 1], [], "statuses recorded twice")
-        # The recorder writes whole steps in order: the bag is in time order.
-        self.assertEqual(rec.out_of_order[:5], [], f"{len(rec.out_of_order)} messages out of time order")
         self.assertEqual(len(rec.states), n * (steps + 1), "states beyond the last step")
+        self.assertEqual(sorted(rec.status), list(range(steps + 1)), "status of every step")
+        self.assertEqual([k for k, msgs in rec.status.items() if len(msgs) != 1], [], "statuses recorded twice")
+        self.assertEqual(rec.out_of_order[:5], [], f"{len(rec.out_of_order)} messages out of time order")
+
+    def check_recording(self, rec, scenario, expected, ns="/formation"):
+        n, steps, h = scenario["n"], int(scenario["steps"]), float(scenario["time_step"])
+        self.check_each_step_once(rec, n, steps)
         mismatches = 0
         for (i, k), msgs in rec.states.items():
             for m in msgs:
@@ -131,7 +136,6 @@ class RunChecks:
                 self.assertLess(abs(m.header.stamp.to_sec() - k * h), 1.01e-9 + 1e-15 * k * h)
                 self.assertAlmostEqual(m.time, k * h, delta=1e-12 * (1 + k * h))
         self.assertEqual(mismatches, 0, f"{mismatches} recorded positions differ from simulate")
-        self.assertEqual(sorted(rec.status), list(range(steps + 1)), "status of every step once")
         # Markers of every step, once (the monitor republishes those the recorder has not confirmed).
         self.assertEqual(sorted(round(t / h) for t in rec.marker_stamps), list(range(steps + 1)))
         # tf: every agent's frame, prefixed by the namespace, at every step, stamped t_k.

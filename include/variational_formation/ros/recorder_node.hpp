@@ -85,8 +85,8 @@ class RecorderNode {
 
   ros::NodeHandle nh_;
   rosbag::Bag bag_;
-  std::string path_, monitor_, framePrefix_, statusTopic_, markersTopic_;
-  std::vector<std::string> stateTopics_;
+  std::string path_, monitor_, statusTopic_, markersTopic_;
+  std::vector<std::string> stateTopics_, frameIds_;  // by agent
   std::vector<ros::Subscriber> subs_;
   ros::Publisher progressPub_;
   RunProgress progress_;
