@@ -52,10 +52,16 @@ vf_build() {
     case "$(basename "$entry")" in output|build|devel) continue ;; esac
     ln -sfn "$entry" "$pkg/$(basename "$entry")"
   done
-  local jobs
+  local jobs launcher=()
   jobs="$(nproc 2>/dev/null || echo 2)"
+  # Where ccache is installed (a developer's machine, not CI's), builds of several checkouts
+  # share one cache: paths below the checkouts' parent are hashed relative.
+  if command -v ccache >/dev/null 2>&1; then
+    export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$(dirname "$REPO")}"
+    launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  fi
   (cd "$WS" && catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 \
-      -DCMAKE_BUILD_TYPE=Release "$@" -j"$jobs" >"$WS/build.log" 2>&1) || {
+      -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "$@" -j"$jobs" >"$WS/build.log" 2>&1) || {
     tail -n 60 "$WS/build.log"
     echo "build failed; full log: $WS/build.log" >&2
     return 1
