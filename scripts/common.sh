@@ -13,23 +13,30 @@ export ROS_HOSTNAME="${ROS_HOSTNAME:-localhost}"
 export MPLCONFIGDIR="$WS/matplotlib"
 export PYTHONDONTWRITEBYTECODE=1
 
-VF_APT_PACKAGES=(
-  build-essential cmake catkin ros-core-dev ros-base-dev libroscpp-dev libtf2-ros-dev
-  ros-geometry-msgs ros-visualization-msgs ros-std-msgs ros-message-generation ros-message-runtime
-  ros-tf2-msgs librosbag-dev python3-rosbag python3-rostest librostest-dev python3-roslaunch
-  rosbash rviz libeigen3-dev libyaml-cpp-dev libgtest-dev googletest libbenchmark-dev
-  python3-matplotlib python3-numpy python3-yaml xvfb x11-apps python3-tf2-ros
-  python3-rosparam python3-rospkg ros-nav-msgs libnav-msgs-dev python3-nav-msgs python3-setuptools
-  python3-rosunit iproute2
-  libdiagnostic-updater-dev python3-dynamic-reconfigure libdynamic-reconfigure-config-init-mutex-dev
-  python3-diagnostic-msgs
-  libnodeletlib-dev libnodeletlib-tools libnodelet-dev pluginlib-dev
-)
+# The Debian packages: every dependency key of package.xml, through the one mapping in
+# scripts/debian_packages.txt (no rosdep database is needed). Plain bash and sed: on a fresh
+# machine nothing else may be installed yet.
+vf_apt_packages() {
+  local key line found
+  for key in $(sed -nE 's#^ *<(buildtool_|build_|build_export_|exec_|test_)?depend>([^<]+)</.*#\2#p' \
+                 "$REPO/package.xml" | sort -u); do
+    found=""
+    while read -r line; do
+      case "$line" in "$key: "*) found="${line#"$key: "}" ;; esac
+    done <"$REPO/scripts/debian_packages.txt"
+    if [ -z "$found" ]; then
+      echo "package.xml: dependency '$key' has no line in scripts/debian_packages.txt" >&2
+      return 1
+    fi
+    echo "$found" | tr ' ' '\n'
+  done | sort -u
+}
 
 vf_install_dependencies() {
-  local missing=()
+  local missing=() packages=()
   local p
-  for p in "${VF_APT_PACKAGES[@]}"; do
+  mapfile -t packages < <(vf_apt_packages) && [ ${#packages[@]} -gt 0 ] || return 1
+  for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
   done
   [ ${#missing[@]} -eq 0 ] && return 0
