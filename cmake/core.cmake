@@ -1,6 +1,9 @@
 # The ROS-free core: Eigen and yaml-cpp only. catkin's include path is not given to this
 # target, but on Debian the ROS headers live in /usr/include beside Eigen's, so that alone
 # cannot stop a ROS include from compiling: test/core/test_layers.cpp is the guard.
+# In the order of the concepts (the formation model, the integrators on it, what uses them),
+# not alphabetical.
+#catkin_lint: ignore_once unsorted_list
 add_library(variational_formation_core
   src/core/formation.cpp
   src/core/variational_update.cpp

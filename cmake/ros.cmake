@@ -1,26 +1,29 @@
 # The ROS layer: thin nodes over the core, plus rostests.
-add_library(variational_formation_ros src/ros/agent_node.cpp src/ros/monitor_node.cpp src/ros/markers.cpp
+add_library(variational_formation_ros src/ros/agent_node.cpp src/ros/markers.cpp src/ros/monitor_node.cpp
   src/ros/participants.cpp
   src/ros/recorder_node.cpp)
 # The time-driven agent (doc/robots.md), selected by the agent's ~mode.
 target_sources(variational_formation_ros PRIVATE src/ros/timed_agent_node.cpp)
 add_dependencies(variational_formation_ros ${PROJECT_NAME}_gencfg)
-target_include_directories(variational_formation_ros SYSTEM PUBLIC ${catkin_INCLUDE_DIRS})
+# catkin's include path is given to each ROS target privately (never exported: catkin_lint).
+target_include_directories(variational_formation_ros SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(variational_formation_ros variational_formation_core ${catkin_LIBRARIES})
 target_compile_options(variational_formation_ros PRIVATE ${VF_FLAGS})
 add_dependencies(variational_formation_ros ${PROJECT_NAME}_generate_messages_cpp ${catkin_EXPORTED_TARGETS})
 
 foreach(node agent monitor recorder agent_manager)
   add_executable(${node} src/ros/${node}_main.cpp)
+  target_include_directories(${node} SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
   target_link_libraries(${node} variational_formation_ros)
   target_compile_options(${node} PRIVATE ${VF_FLAGS})
   install(TARGETS ${node} RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 endforeach()
 # The agent as a nodelet plugin (nodelet_plugins.xml), over the same AgentNode.
 add_library(variational_formation_nodelets src/ros/agent_nodelet.cpp)
+target_include_directories(variational_formation_nodelets SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(variational_formation_nodelets variational_formation_ros)
 target_compile_options(variational_formation_nodelets PRIVATE ${VF_FLAGS})
-install(TARGETS variational_formation_ros variational_formation_nodelets
+install(TARGETS variational_formation_nodelets variational_formation_ros
   ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
 
