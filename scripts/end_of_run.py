@@ -12,6 +12,9 @@ from variational_formation.msg import RunProgress
 
 
 def main():
+    if any(a in ("-h", "--help") for a in sys.argv[1:]):
+        print("usage: rosrun variational_formation end_of_run.py [_monitor:=NAME]\n" + __doc__)
+        return
     rospy.init_node("end_of_run")
     monitor = rospy.resolve_name(rospy.get_param("~monitor", "monitor"))
     namespace = rospy.get_namespace()

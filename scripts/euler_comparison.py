@@ -7,7 +7,8 @@ usage: euler_comparison.py [--scenario config/square.yaml] [--duration 15] [--ou
 Prints, per method and h: bounded or not, the final formation error, and the time at which
 the energy fell below 1e-6 of its initial value; writes euler_comparison.png (trajectories and
 energy side by side; 3D scenarios are drawn in 3D). The simulate binary is looked up in
-$VF_WS (default .ws in the repository), then on PATH, unless --simulate is given.
+$VF_WS (default .ws in the repository), beside this script (an install space), then on PATH,
+unless --simulate is given. Installed, the defaults are the package's square and ./output.
 """
 import argparse
 import os
@@ -23,7 +24,12 @@ sys.path.append(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "
 from variational_formation import data, plots  # noqa: E402
 from variational_formation.cli import fail  # noqa: E402
 
-REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(HERE)
+# A checkout has package.xml at REPO; an install space keeps this script in
+# <prefix>/lib/variational_formation and the package's files in <prefix>/share/variational_formation.
+CHECKOUT = os.path.isfile(os.path.join(REPO, "package.xml"))
+SHARE = REPO if CHECKOUT else os.path.join(HERE, "..", "..", "share", "variational_formation")
 STEPS_H = (0.05, 0.008, 0.005)
 METHODS = (("vi", "variational"), ("euler", "explicit Euler"))
 
@@ -35,7 +41,7 @@ def find_simulate(given):
         return given
     workspace = os.environ.get("VF_WS") or os.path.join(REPO, ".ws")
     for candidate in (os.path.join(workspace, "devel/lib/variational_formation/simulate"),
-                      shutil.which("simulate")):
+                      os.path.join(HERE, "simulate"), shutil.which("simulate")):
         if candidate and os.access(candidate, os.X_OK):
             return candidate
     fail(f"no simulate binary in {workspace} or on PATH; build first (./scripts/test.sh) or pass --simulate")
@@ -54,9 +60,9 @@ def run(simulate, scenario, method, h, steps, tmp):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--scenario", default=os.path.join(REPO, "config/square.yaml"))
+    parser.add_argument("--scenario", default=os.path.normpath(os.path.join(SHARE, "config", "square.yaml")))
     parser.add_argument("--duration", type=float, default=15.0)
-    parser.add_argument("--out-dir", default=os.path.join(REPO, "output"))
+    parser.add_argument("--out-dir", default=os.path.join(REPO, "output") if CHECKOUT else "output")
     parser.add_argument("--simulate", default=None)
     args = parser.parse_args()
     if not args.duration > 0:

@@ -27,6 +27,9 @@ def reasons(root, width):
 
 
 if __name__ == "__main__":
+    if len(sys.argv) == 2 and sys.argv[1] in ("-h", "--help"):
+        print(__doc__)
+        sys.exit(0)
     if len(sys.argv) not in (2, 3) or not os.path.isdir(sys.argv[1]):
         sys.exit("usage: failure_reasons.py TEST_RESULTS_DIR [MAX_CHARS]")
     for line in reasons(sys.argv[1], int(sys.argv[2]) if len(sys.argv) == 3 else 400):

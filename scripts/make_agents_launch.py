@@ -189,8 +189,11 @@ def main():
     lines.append("</launch>")
     try:
         os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
-        with open(args.out, "w") as f:
+        # Written beside and renamed over: a launch reading the same file meanwhile sees it whole.
+        partial = f"{args.out}.{os.getpid()}.partial"
+        with open(partial, "w") as f:
             f.write("\n".join(lines) + "\n")
+        os.replace(partial, args.out)
     except OSError as e:
         fail(f"--out: cannot write {args.out}: {e.strerror}")
     print(args.out)

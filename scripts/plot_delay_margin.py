@@ -16,8 +16,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import vf_plots  # noqa: E402
+# The package is importable once devel/setup.bash is sourced; this also finds it in a checkout.
+sys.path.append(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "src"))
+from variational_formation import data  # noqa: E402
+from variational_formation.cli import fail  # noqa: E402
 
 HEADER = ("delay_steps,loss,runs,congruent_fraction,median_congruent_step,median_congruent_time,"
           "lost_fraction,predicted_margin,predicted_capped,unstable_roots")
@@ -29,7 +31,9 @@ def main():
     parser.add_argument("--out", required=True)
     parser.add_argument("--title", default=None)
     args = parser.parse_args()
-    rows = vf_plots.load_csv(args.summary, HEADER)
+    rows = data.load_csv(args.summary, HEADER)
+    if rows.shape[0] == 0:
+        fail(f"{args.summary}: no rows")
     delays = sorted({int(r[0]) for r in rows})
     losses = sorted({float(r[1]) for r in rows})
     fraction = np.full((len(losses), len(delays)), np.nan)
@@ -61,7 +65,10 @@ def main():
                  fontsize=9)
     fig.colorbar(image, ax=ax, label="fraction congruent")
     fig.tight_layout()
-    fig.savefig(args.out, dpi=110)
+    try:
+        fig.savefig(args.out, dpi=110)
+    except OSError as e:
+        fail(f"--out: cannot write {args.out}: {e.strerror}")
     print("plot_delay_margin: wrote %s" % args.out)
 
 

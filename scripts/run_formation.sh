@@ -6,6 +6,9 @@
 # was written (a bad argument or scenario stops the launch before the monitor runs).
 # usage: run_formation.sh [roslaunch args...] scenario:=S [output_dir:=DIR] [other formation.launch args]
 set -uo pipefail
+case "${1:-}" in
+  -h|--help) sed -n '2,/^# usage/p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+esac
 scenario=tetrahedron
 output_dir="$HOME/.ros"
 for a in "$@"; do

@@ -20,6 +20,7 @@
 #include <ros/ros.h>
 
 #include "variational_formation/core/error.hpp"
+#include "variational_formation/ros/node_main.hpp"
 #include "variational_formation/ros/parameters.hpp"
 
 namespace {
@@ -70,9 +71,17 @@ void setAgentParameters(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, i
   agent.setParam("agent_manager", ros::this_node::getName() + " " + vf::optionalParam<std::string>(pnh, "agent_manager", ""));
 }
 
+const char* const kUsage =
+    "usage: rosrun variational_formation agent_manager [ROS remappings and _param:=value]\n"
+    "A nodelet manager that loads its own agents (variational_formation/Agent) at start.\n"
+    "Private parameters: ~agents (required: ids separated by spaces), ~scenario,\n"
+    "~real_time_factor, ~monitor, ~agent_manager, ~stagger [s], ~num_worker_threads.\n"
+    "Started by formation.launch nodelet:=true; see doc/distributed.md, \"Nodelets\".\n";
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (vf::printedUsage(argc, argv, kUsage)) return 0;
   ros::init(argc, argv, "manager");
   ros::NodeHandle nh, pnh("~");
   const std::string me = ros::this_node::getName();

@@ -10,7 +10,13 @@
 
 int main(int argc, char** argv) {
   try {
-    const vf::Arguments args(argc, argv, {{"--scenario", 1}, {"--real-time-factor", 1}});
+    const vf::Arguments args(argc, argv, {{"--scenario", 1}, {"--real-time-factor", 1}, {"--help", 0}, {"-h", 0}});
+    if (args.has("--help") || args.has("-h")) {
+      std::cout << "usage: scenario_info --scenario FILE [--real-time-factor R]\n"
+                   "Checks a scenario (and a pacing factor for it) through the package's one validation\n"
+                   "path and prints \"agents N\"; warnings go to stderr. Exit status 2 on bad input.\n";
+      return vf::kExitOk;
+    }
     const vf::Scenario s = vf::loadScenario(args.text("--scenario"));
     if (args.has("--real-time-factor")) {
       vf::validateRealTimeFactor(args.number("--real-time-factor"), s.timeStep, "--real-time-factor");

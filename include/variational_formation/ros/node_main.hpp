@@ -1,5 +1,7 @@
 #pragma once
 
+#include <cstdio>
+#include <cstring>
 #include <type_traits>
 
 #include <ros/ros.h>
@@ -7,12 +9,27 @@
 namespace vf {
 
 /**
- * The whole main of a node: init, construct (which reads and checks the parameters), run.
+ * True, with `usage` printed on stdout, when the command line asks for it (`--help` or `-h`):
+ * main then exits 0. Checked before ros::init, so it needs no master.
+ */
+inline bool printedUsage(int argc, char** argv, const char* usage) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0) {
+      std::fputs(usage, stdout);
+      return true;
+    }
+  }
+  return false;
+}
+
+/**
+ * The whole main of a node: usage on --help, init, construct (which reads and checks the parameters), run.
  * A bad configuration is one ROS_FATAL line and exit status 2; nothing escapes. A node whose
  * run() returns an int exits with it.
  */
 template <class Node>
-int runNode(int argc, char** argv, const char* name) {
+int runNode(int argc, char** argv, const char* name, const char* usage) {
+  if (printedUsage(argc, argv, usage)) return 0;
   ros::init(argc, argv, name);
   ros::NodeHandle nh, pnh("~");
   try {
