@@ -1,17 +1,31 @@
 #!/usr/bin/env bash
-# Installs the dependencies, builds, runs every gtest and rostest, and ends with
-# "N passed, M failed". Exits non-zero on any failure.
+# Installs the dependencies, builds, runs every gtest, rostest and Python test (one line each
+# as it finishes, then the ten slowest), and ends with "N passed, M failed". Exits non-zero on
+# any failure.
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 vf_install_dependencies
 werror=()
 [ -n "${CI:-}" ] && werror=(-DVF_WERROR=ON)
+echo "building the package (log: $WS/build.log)"
 vf_build "${werror[@]}"
 vf_source
 cd "$WS"
 rm -rf "$WS/build/test_results"
+mkdir -p "$WS/build/test_results"
 status=0
-# Build the tests on every core, then run them one at a time (rostests share the machine).
-catkin_make tests -j"$(nproc)" >"$WS/tests.log" 2>&1 && catkin_make run_tests -j1 >>"$WS/tests.log" 2>&1 || status=$?
+# Build the tests on every core, then run them one at a time (rostests share the machine),
+# with a line per test as it finishes (scripts/test_progress.py) and the ten slowest at the end.
+echo "building the tests (log: $WS/tests.log)"
+catkin_make tests -j"$(nproc)" >"$WS/tests.log" 2>&1 || status=$?
+if [ "$status" -eq 0 ]; then
+  echo "running the tests, one at a time: result, seconds, result file"
+  catkin_make run_tests -j1 >>"$WS/tests.log" 2>&1 &
+  run=$!
+  /usr/bin/python3 "$REPO/scripts/test_progress.py" "$WS/build/test_results" "$run" &
+  progress=$!
+  wait "$run" || status=$?
+  wait "$progress" || true
+fi
 results="$(catkin_test_results "$WS/build/test_results" 2>&1 || true)"
 echo "$results" | grep -vE '^Skipping' || true
 summary="$(echo "$results" | grep -E '^Summary:' | tail -n 1)"
