@@ -123,7 +123,12 @@ class InstallTest(unittest.TestCase):
     def test_hexagon_runs_from_the_install_space(self):
         port = free_port()
         out = os.path.join(self.root, "out")
-        hide = os.geteuid() == 0 and shutil.which("unshare") is not None
+        # Hiding the tree needs a private mount namespace (root with CAP_SYS_ADMIN, as CI's
+        # multi-host test needs too); elsewhere the run still uses only the install space's
+        # environment, and the test above shows that nothing installed names the tree.
+        hide = os.geteuid() == 0 and run(["unshare", "--mount", "true"]).returncode == 0
+        if not hide:
+            print("the source tree stays visible: no private mount namespace here", file=sys.stderr)
         command = (f"export ROS_MASTER_URI=http://localhost:{port}; "
                    f"rosrun {PKG} run_formation.sh -p {port} scenario:=hexagon output_dir:={out}")
         result = self.in_install(command, timeout=300, hide_source=hide)
