@@ -109,10 +109,21 @@ class InstallTest(unittest.TestCase):
         names = sorted(f for f in os.listdir(folder) if os.access(os.path.join(folder, f), os.X_OK)
                        and os.path.isfile(os.path.join(folder, f)))
         self.assertGreater(len(names), 15)
-        for name in names:
-            result = self.in_install(f"rosrun {PKG} {name} --help", timeout=30)
-            self.assertEqual(result.returncode, 0, f"{name} --help: {result.stdout}{result.stderr}")
-            self.assertRegex(result.stdout.lower(), r"usage", f"{name} --help printed no usage")
+        # One shell for all (each by its installed path; rosrun itself is exercised by the run
+        # below): per program, a line "=== NAME STATUS" and then its output.
+        loop = (f'cd {folder}; for f in {" ".join(names)}; do out="$(./"$f" --help 2>&1)"; '
+                'echo "=== $f $?"; echo "$out"; done')
+        result = self.in_install(loop, timeout=120)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        outputs = {}
+        for block in result.stdout.split("=== ")[1:]:
+            head, _, text = block.partition("\n")
+            name, status = head.rsplit(" ", 1)
+            outputs[name] = (int(status), text)
+        self.assertEqual(sorted(outputs), names)
+        for name, (status, text) in outputs.items():
+            self.assertEqual(status, 0, f"{name} --help: exit {status}: {text}")
+            self.assertRegex(text.lower(), r"usage", f"{name} --help printed no usage")
 
     def test_python_package_and_messages_import(self):
         result = self.in_install("/usr/bin/python3 -c 'import variational_formation.plots, "
