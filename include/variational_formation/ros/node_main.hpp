@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <cstring>
+#include <string>
 #include <type_traits>
 
 #include <ros/ros.h>
@@ -23,13 +24,15 @@ inline bool printedUsage(int argc, char** argv, const char* usage) {
 }
 
 /**
- * The whole main of a node: usage on --help, init, construct (which reads and checks the parameters), run.
- * A bad configuration is one ROS_FATAL line and exit status 2; nothing escapes. A node whose
- * run() returns an int exits with it.
+ * The whole main of a node: usage on --help (a generic line if `usage` is null), init,
+ * construct (which reads and checks the parameters), run. A bad configuration is one ROS_FATAL
+ * line and exit status 2; nothing escapes. A node whose run() returns an int exits with it.
  */
 template <class Node>
-int runNode(int argc, char** argv, const char* name, const char* usage) {
-  if (printedUsage(argc, argv, usage)) return 0;
+int runNode(int argc, char** argv, const char* name, const char* usage = nullptr) {
+  const std::string generic = std::string("usage: rosrun variational_formation ") + name +
+                              " [ROS remappings and _param:=value]\n";
+  if (printedUsage(argc, argv, usage != nullptr ? usage : generic.c_str())) return 0;
   ros::init(argc, argv, name);
   ros::NodeHandle nh, pnh("~");
   try {
