@@ -338,6 +338,17 @@ def same_default(code, documented):
         return code == documented
 
 
+def heading_slugs(markdown):
+    """GitHub's anchors for the headings of a page."""
+    slugs = set()
+    for line in markdown.splitlines():
+        m = re.match(r"^#{1,6} (.*)$", line)
+        if m:
+            slug = re.sub(r"[^\w\- ]", "", m.group(1).strip().lower()).replace(" ", "-")
+            slugs.add(slug)
+    return slugs
+
+
 class Docs(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -366,7 +377,7 @@ class Docs(unittest.TestCase):
         self.assertEqual(missing, [], "read by the code but missing from doc/ros_api.md:\n" + "\n".join(missing))
 
     def test_every_documented_parameter_is_read(self):
-        read = {r.name for r in self.reads}
+        names_read = {r.name for r in self.reads}
         unread = []
         for name, specs in sorted(self.doc.specs.items()):
             libraries = {s[3] for s in specs if s[3]}
@@ -376,7 +387,7 @@ class Docs(unittest.TestCase):
                     unread.append(f"~{name}: read by '{library}', a library this test does not know")
                 elif not any(evidence in read(p) for p in source_files((".cpp", ".hpp"))):
                     unread.append(f"~{name}: read by {library}, but no source uses {evidence}")
-            if not libraries and name not in read:
+            if not libraries and name not in names_read:
                 unread.append(f"~{name} (in {', '.join(s[0] for s in specs)})")
         self.assertEqual(unread, [], "listed in doc/ros_api.md but read by no node:\n" + "\n".join(unread))
 
@@ -426,6 +437,27 @@ class Docs(unittest.TestCase):
                 if re.match(r"^\|\s*`~\w+`", line):
                     tables.append(f"{relative(path)}:{number}: {line.strip()[:60]}")
         self.assertEqual(tables, [], "parameter tables outside doc/ros_api.md (link to it instead):\n" + "\n".join(tables))
+
+    def test_links_resolve(self):
+        # Every relative link in README.md and doc/*.md names a file that exists and, with
+        # #anchor, a heading of that page (GitHub's slugs): sections moved, links followed.
+        pages = [os.path.join(ROOT, "README.md")] + [
+            os.path.join(ROOT, "doc", n) for n in sorted(os.listdir(os.path.join(ROOT, "doc"))) if n.endswith(".md")]
+        broken = []
+        for page in pages:
+            text = read(page)
+            for m in re.finditer(r"\]\(([^)\s]+)\)", text):
+                target = m.group(1)
+                if re.match(r"^[a-z]+:", target):
+                    continue
+                path, _, anchor = target.partition("#")
+                full = os.path.normpath(os.path.join(os.path.dirname(page), path)) if path else page
+                where = f"{relative(page)}:{text.count(chr(10), 0, m.start()) + 1}: {target}"
+                if not os.path.exists(full):
+                    broken.append(where + " (no such file)")
+                elif anchor and full.endswith(".md") and anchor not in heading_slugs(read(full)):
+                    broken.append(where + " (no such heading)")
+        self.assertEqual(broken, [], "broken links:\n" + "\n".join(broken))
 
     def test_readme_is_a_front_door(self):
         with open(os.path.join(ROOT, "README.md"), encoding="utf-8") as f:
