@@ -9,7 +9,9 @@
   and dynamic_reconfigure's cfg/*.cfg. A read whose name this test cannot tell fails it, so a
   new way of reading parameters has to be taught here instead of slipping through.
 - A default the code gives as a plain literal is one of the defaults the document gives.
-- Every node executable, nodelet and node script of the package has a section there.
+- Every node executable, nodelet and node script of the package has a section there, and each
+  <param> a launch file gives one of its nodes is listed in that node's section.
+- Every relative link in README.md and doc/*.md reaches an existing file and heading.
 - No other page keeps a parameter table of its own (one list), and README.md has at most 200
   lines.
 
@@ -425,6 +427,40 @@ class Docs(unittest.TestCase):
         headings = " ".join(self.doc.sections)
         missing = sorted(n for n in nodes if not re.search(r"(^|[\s`(])" + re.escape(n) + r"($|[\s`)])", headings))
         self.assertEqual(missing, [], "nodes without a section in doc/ros_api.md: " + ", ".join(missing))
+
+    def test_launch_parameters_are_documented_for_their_node(self):
+        # A <param> a launch file gives one of the package's nodes is a parameter of that node's
+        # section (a misspelt name would be set and never read). The node's section is found by
+        # its type, or by its name where the type is computed ($(eval ...): the agent).
+        import xml.etree.ElementTree as ElementTree
+        by_section = {}
+        for name, specs in self.doc.specs.items():
+            for s in specs:
+                by_section.setdefault(s[0], set()).add(name)
+        for name, sections in self.doc.references.items():
+            for section in sections:
+                by_section.setdefault(section, set()).add(name)
+        wrong, checked = [], 0
+        for folder, _, names in os.walk(os.path.join(ROOT, "launch")):
+            for launch in sorted(n for n in names if n.endswith(".launch")):
+                path = os.path.join(folder, launch)
+                for node in ElementTree.parse(path).getroot().iter("node"):
+                    pkg, kind = node.get("pkg", ""), node.get("type", "")
+                    if pkg != "variational_formation" and "$(" not in pkg:
+                        continue
+                    kind = kind if "$(" not in kind else re.sub(r"_?\$\(.*", "", node.get("name", ""))
+                    documented = set()
+                    for section, params in by_section.items():
+                        if re.sub(r"[`]", "", section).split(" ")[0] == kind:
+                            documented |= params
+                    for param in list(node.iter("param")) + list(node.iter("rosparam")):
+                        name = param.get("name") or param.get("param")
+                        checked += 1
+                        if name not in documented:
+                            wrong.append(f"{relative(path)}: node {node.get('name')} ({kind}) gets ~{name}, "
+                                         "which its section of doc/ros_api.md does not list")
+        self.assertGreater(checked, 20, "implausibly few launch parameters found")
+        self.assertEqual(wrong, [], "\n".join(wrong))
 
     def test_one_parameter_list(self):
         pages = [os.path.join(ROOT, "README.md")] + [
