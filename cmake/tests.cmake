@@ -13,3 +13,11 @@ if(CATKIN_ENABLE_TESTING)
   target_compile_options(test_simulate_cli PRIVATE ${VF_FLAGS})
   target_compile_definitions(test_simulate_cli PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 endif()
+
+# The documentation against the code (test/doc/test_docs.py): doc/ros_api.md lists exactly the
+# parameters the nodes read, and README.md stays a front door. No ROS master; named like the
+# multihost test (not rosunit-*.xml, which scripts/test.sh pairs with rostest wrappers).
+if(CATKIN_ENABLE_TESTING)
+  catkin_run_tests_target("unittest" docs "unittest-docs.xml"
+    COMMAND "/usr/bin/python3 ${PROJECT_SOURCE_DIR}/test/doc/test_docs.py --gtest_output=xml:${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/unittest-docs.xml")
+endif()

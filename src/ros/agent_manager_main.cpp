@@ -4,12 +4,9 @@
 // out under load, and a respawned loader clashes with its old name). It is still an ordinary
 // manager: `nodelet load TYPE <this manager>` (agent.launch manager:=NAME) adds more nodelets.
 //
-// Private parameters:
-//   ~agents             ids of the agents to load, separated by spaces (required)
-//   ~scenario, ~real_time_factor, ~monitor, ~agent_manager
-//                       passed to every agent as its private parameters (AgentNode checks them)
-//   ~stagger            seconds between two loads (default 0)
-//   ~num_worker_threads the manager's worker threads (nodelet's own parameter, default 4)
+// Private parameters (doc/ros_api.md, "agent_manager"): ~agents (required), ~stagger, and
+// ~scenario, ~real_time_factor, ~monitor, ~agent_manager passed on to every agent (AgentNode
+// checks them); nodelet itself reads ~num_worker_threads.
 #include <cmath>
 #include <set>
 #include <sstream>

@@ -39,9 +39,8 @@ using variational_formation::RunProgress;
  * until shut down (a respawning node that exited would only be restarted); its exit status is
  * then 0 if the run finished, 1 if it failed.
  *
- * Private parameters: ~id, ~scenario (required), ~real_time_factor (0 = as fast as possible),
- * ~monitor (name of the monitor node, relative to the namespace; default "monitor"), ~agent_manager
- * (nodelet managers whose caller id a neighbour's state may carry; default none).
+ * Topics, services and private parameters (types, defaults, meaning): doc/ros_api.md, "agent
+ * (lockstep mode)", the one list (test/doc/test_docs.py keeps it in step with the code).
  */
 class AgentNode {
  public:

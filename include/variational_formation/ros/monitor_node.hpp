@@ -32,13 +32,7 @@ using variational_formation::RunProgress;
  * seconds what a stalled run waits for, ends the run as failed when a participant dies, and
  * writes the outcome to ~result_file. Maths: FormationMonitor.
  *
- * Private parameters: ~scenario (required), ~trail_length (100), ~window (100), ~recorder (name
- * of the recorder node, "" = no recording), ~result_file ("" = none), ~wait_for_viewer (false:
- * with true, the start also waits for a subscriber of `markers`, i.e. rviz), ~respawn_timeout
- * (seconds a dead agent may take to come back before the run fails; 0 = fail at once),
- * ~marker_every (1: markers of every k-th step, and of the first and last; none are built while
- * nobody subscribes and nothing is recorded), ~agent_manager (nodelet managers whose caller id an
- * agent's state may carry; "" = none).
+ * Topics, services and private parameters: doc/ros_api.md, "monitor".
  *
  * Timed mode (~mode timed, ~real_time_factor > 0; doc/robots.md): the agents do not wait for each
  * other, so there are no completed steps to wait for. Once every agent's first state is there it

@@ -44,8 +44,7 @@ using variational_formation::RunProgress;
  * agent that republishes after a restart) is not written, and a repeated state that differs
  * from the written one, bit for bit, fails the run (RecordLedger).
  *
- * Private parameters: ~scenario, ~bag (both required), ~monitor (default "monitor"),
- * ~split_size, ~max_size.
+ * Topics, services and private parameters: doc/ros_api.md, "recorder".
  */
 class RecorderNode {
  public:

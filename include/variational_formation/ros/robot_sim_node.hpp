@@ -16,10 +16,8 @@ namespace vf {
  * tracks `cmd_vel` (geometry_msgs/Twist, linear part, world axes) and publishes `odom`
  * (nav_msgs/Odometry, noisy position, frame world) and the tf world -> <prefix>robot_<id>/base_link
  * (true position). Topics are relative: run one per robot in its own namespace, or remap them.
- * Private parameters: ~id, ~initial_position (required; 2 or 3 numbers, m), ~rate (Hz, 100),
- * ~lag (s, 0.1), ~max_speed (m/s, 2), ~max_acceleration (m/s^2, 20), ~odometry_noise (m, 0.01),
- * ~seed (default: id), ~cmd_timeout (s, 0.5; 0 = never: a robot stops when its commands stop),
- * ~frame_prefix (default: the namespace without the leading '/', followed by '/').
+ * Private parameters: doc/ros_api.md, "robot_sim" (a robot stops when its commands stop for
+ * ~cmd_timeout).
  */
 class RobotSimNode {
  public:

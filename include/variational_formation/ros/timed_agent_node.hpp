@@ -44,8 +44,7 @@ using variational_formation::RunProgress;
  * dynamic_reconfigure (`rosrun dynamic_reconfigure dynparam set /formation/agent_0 kappa 6`): kappa,
  * starting from the scenario's; lockstep keeps it fixed, so that it stays bit for bit exact.
  *
- * Private parameters: ~id, ~scenario (required), ~real_time_factor (> 0), ~monitor ("monitor"),
- * ~delay, ~jitter [s] (0), ~loss (0, probability), ~seed (id), ~max_age [s] (0.5), ~robot (false).
+ * Topics, services and private parameters: doc/ros_api.md, "agent (timed mode)".
  */
 class TimedAgentNode {
  public:
