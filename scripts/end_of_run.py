@@ -62,12 +62,11 @@ def main():
     namespace = rospy.get_namespace()
     launcher = os.getppid()
     launch = process_id(launcher)
-    state = {"over": False, "now": False}
+    state = {"over": False, "now": False, "marked": False}
 
     def over(why, at_once=False):
         if not state["over"]:
             state["over"] = True
-            rospy.set_param("~over", launch)
             rospy.loginfo("end_of_run: %s", why)
         state["now"] = state["now"] or at_once
 
@@ -93,10 +92,14 @@ def main():
         if not state["over"]:
             continue
         try:
+            if not state["marked"]:
+                rospy.set_param("~over", launch)
+                state["marked"] = True
             others = formations()
             everyone = state["now"] or all(rospy.get_param(f + "/over", None) == launch for f in others)
-        except (OSError, rospy.ROSException):
-            continue  # the master is going away with the launch
+        except Exception as e:  # the master may be busy, or going away with the launch: ask again
+            rospy.logwarn_throttle(5.0, f"end_of_run: cannot ask the master which formations are over ({e})")
+            continue
         # One sender: a second SIGINT would cut roslaunch's own shutdown short.
         if everyone and (state["now"] or not others or others[0] == rospy.get_name()):
             if started_by_roslaunch(launcher):

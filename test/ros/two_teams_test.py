@@ -13,6 +13,7 @@
 """
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import unittest
@@ -28,11 +29,18 @@ TEAMS = {"team_a": "hexagon", "team_b": "tetrahedron"}
 RED = "\x1b[31m"
 
 
-def roslaunch(*args, timeout=180):
-    """roslaunch on the test's master: (exit status, everything it printed)."""
-    run = subprocess.run(["roslaunch", *args], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                         timeout=timeout)
-    return run.returncode, run.stdout
+def roslaunch(*args, timeout=120):
+    """roslaunch on the test's master: (exit status, everything it printed). One that has not
+    ended by itself within `timeout` is stopped with SIGINT: status None."""
+    launch = subprocess.Popen(["roslaunch", *args], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                              start_new_session=True)
+    try:
+        out, _ = launch.communicate(timeout=timeout)
+        return launch.returncode, out
+    except subprocess.TimeoutExpired:
+        os.killpg(launch.pid, signal.SIGINT)
+        out, _ = launch.communicate(timeout=60)
+        return None, out + f"\n(did not end by itself within {timeout} s)"
 
 
 def result(path):
@@ -75,7 +83,7 @@ class TwoTeams(unittest.TestCase, vf_rostest.RunChecks):
         out = os.path.join(self.out, "launched")
         launch = os.path.join(os.path.dirname(os.path.abspath(__file__)), "two_teams.launch")
         status, log = roslaunch(launch, f"output_dir:={out}", "record:=false", "team_a:=side_a", "team_b:=side_b")
-        self.assertEqual(status, 0, log[-3000:])
+        self.assertEqual(status, 0, log[-6000:])
         for side, name in (("side_a", "hexagon"), ("side_b", "tetrahedron")):
             self.assertEqual(result(os.path.join(out, f"{side}_{name}.result.yaml")), "succeeded", log[-3000:])
         self.assertNotIn("REQUIRED process", log)
