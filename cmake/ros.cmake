@@ -1,6 +1,7 @@
 # The ROS layer: thin nodes over the core, plus rostests.
 add_library(variational_formation_ros src/ros/agent_node.cpp src/ros/markers.cpp src/ros/monitor_node.cpp
   src/ros/participants.cpp
+  src/ros/output_files.cpp
   src/ros/recorder_node.cpp)
 # The time-driven agent (doc/robots.md), selected by the agent's ~mode.
 target_sources(variational_formation_ros PRIVATE src/ros/timed_agent_node.cpp)
@@ -69,7 +70,7 @@ if(CATKIN_ENABLE_TESTING)
   add_rostest(test/ros/robots_run.test)
   # SIGKILL to the nodelet manager of every agent during a recorded run: test/ros/nodelet_fault.test.
   add_rostest(test/ros/nodelet_fault.test ARGS seed:=3)
-  foreach(t two_formations launch)
+  foreach(t two_formations two_teams launch)
     add_rostest(test/ros/${t}.test)
   endforeach()
   # Agents on three network-namespace hosts sharing one master (needs root, as in CI). Not a

@@ -21,3 +21,12 @@ if(CATKIN_ENABLE_TESTING)
   catkin_run_tests_target("unittest" docs "unittest-docs.xml"
     COMMAND "/usr/bin/python3 ${PROJECT_SOURCE_DIR}/test/doc/test_docs.py --gtest_output=xml:${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/unittest-docs.xml")
 endif()
+
+# Python tests of the plotting scripts and of scenario names (test/python), one JUnit file each
+# (rosunit's --gtest_output, as the multihost test in cmake/ros.cmake).
+if(CATKIN_ENABLE_TESTING)
+  foreach(t plot_inputs scenario_names)
+    catkin_run_tests_target("unittest" ${t} "unittest-${t}.xml"
+      COMMAND "/usr/bin/python3 ${PROJECT_SOURCE_DIR}/test/python/test_${t}.py --gtest_output=xml:${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/unittest-${t}.xml")
+  endforeach()
+endif()

@@ -5,6 +5,11 @@ add_library(variational_formation_tools
   src/tools/simulate_cli.cpp
 )
 target_link_libraries(variational_formation_tools PUBLIC variational_formation_core)
+# Scenario names (--scenario hexagon) are looked up without ROS too: in the installed share
+# folder and in the source folder of this build (tools/scenario_path.hpp).
+target_sources(variational_formation_tools PRIVATE src/tools/scenario_path.cpp)
+set_source_files_properties(src/tools/scenario_path.cpp PROPERTIES COMPILE_DEFINITIONS
+  "VF_INSTALLED_CONFIG_DIR=\"${CMAKE_INSTALL_PREFIX}/${CATKIN_PACKAGE_SHARE_DESTINATION}/config\";VF_SOURCE_CONFIG_DIR=\"${PROJECT_SOURCE_DIR}/config\"")
 target_compile_options(variational_formation_tools PRIVATE ${VF_FLAGS})
 
 add_executable(simulate src/tools/simulate_main.cpp)
@@ -34,4 +39,8 @@ if(CATKIN_ENABLE_TESTING)
   target_link_libraries(test_make_scenario variational_formation_tools gtest_main)
   target_compile_options(test_make_scenario PRIVATE ${VF_FLAGS})
   target_compile_definitions(test_make_scenario PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  catkin_add_gtest(test_scenario_path test/tools/test_scenario_path.cpp)
+  target_link_libraries(test_scenario_path variational_formation_tools gtest_main)
+  target_compile_options(test_scenario_path PRIVATE ${VF_FLAGS})
+  target_compile_definitions(test_scenario_path PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 endif()

@@ -2,7 +2,7 @@
 """The paper's Euler comparison (Section 6.1): the square scenario with the variational
 integrator and with explicit Euler at h = 0.05, 0.008 and 0.005, over the same simulated time.
 
-usage: euler_comparison.py [--scenario config/square.yaml] [--duration 15] [--out-dir output]
+usage: euler_comparison.py [--scenario FILE|NAME (square)] [--duration 15] [--out-dir output]
                            [--simulate PATH]
 Prints, per method and h: bounded or not, the final formation error, and the time at which
 the energy fell below 1e-6 of its initial value; writes euler_comparison.png (trajectories and
@@ -22,7 +22,7 @@ import numpy as np
 # The package is importable once devel/setup.bash is sourced; this also finds it in a checkout.
 sys.path.append(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "src"))
 from variational_formation import data, plots  # noqa: E402
-from variational_formation.cli import fail  # noqa: E402
+from variational_formation.cli import description, fail  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
@@ -59,7 +59,7 @@ def run(simulate, scenario, method, h, steps, tmp):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=description(__doc__))
     parser.add_argument("--scenario", default=os.path.normpath(os.path.join(SHARE, "config", "square.yaml")))
     parser.add_argument("--duration", type=float, default=15.0)
     parser.add_argument("--out-dir", default=os.path.join(REPO, "output") if CHECKOUT else "output")
@@ -68,6 +68,7 @@ def main():
     if not args.duration > 0:
         fail("--duration: must be > 0")
     simulate = find_simulate(args.simulate)
+    args.scenario = data.scenario_path(args.scenario)
     scenario = data.read_scenario(args.scenario)
     runs, rows = [], []
     with tempfile.TemporaryDirectory() as tmp:

@@ -11,6 +11,7 @@ usage: make_agents_launch.py --scenario FILE --out FILE [--rate R] [--order forw
                              [--stagger SECONDS] [--respawn true|false] [--nodelet true|false [--nodelet-threads N (0: auto)]]
                              [--mode lockstep|timed [--delay S] [--jitter S] [--loss P] [--max-age S]
                               [--seed N] [--respawn-delay S] [--robot true|false [--lag S] [--noise M]]]
+                             [--in-launch]
 With --robot true (timed mode), each agent also gets a simulated robot, robot_sim, in
 formation/robot_<id> (odom and cmd_vel there), started at the scenario's initial position.
 With --nodelet true (lockstep mode), every agent is a nodelet of one manager, formation/manager
@@ -28,7 +29,21 @@ import yaml
 
 
 def fail(message):
+    """One line on stderr and exit status 2. With --in-launch (formation.launch), the status is 0
+    and --out is a launch file that ends roslaunch quietly with status 2 once included: a failed
+    <param command> would make roslaunch add a multi-line dump of the command to the line."""
     print(f"make_agents_launch: error: {message}", file=sys.stderr, flush=True)
+    argv = sys.argv[1:]
+    if "--in-launch" in argv and "--out" in argv[:-1]:
+        out = argv[argv.index("--out") + 1]
+        try:
+            with open(out, "w") as f:
+                f.write("<launch>\n  <!-- make_agents_launch.py: bad input, said on stderr -->\n"
+                        '  <arg name="bad_input" value="$(eval exit(2))"/>\n</launch>\n')
+            print(out)
+            sys.exit(0)
+        except OSError:
+            pass
     sys.exit(2)
 
 
@@ -159,6 +174,7 @@ def main():
     parser.add_argument("--noise", type=non_negative("noise"), default="0.01")
     parser.add_argument("--nodelet", type=boolean("nodelet"), default="false")
     parser.add_argument("--nodelet-threads", type=non_negative_int("nodelet_threads"), default="0")
+    parser.add_argument("--in-launch", action="store_true")
     parser.error = lambda message: fail(message.replace("argument --", ""))
     args = parser.parse_args()
     if args.robot == "true" and args.mode != "timed":

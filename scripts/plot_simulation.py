@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
-"""Turns simulate's traj.csv and metrics.csv into PNGs and prints a summary.
+"""Turns simulate's traj.csv and metrics.csv into PNGs and prints a summary. The scenario is a
+file or a name in the package's config/; files of another formation (agent count, dimension,
+step count) are refused.
 
-usage: plot_simulation.py --scenario FILE --traj traj.csv --metrics metrics.csv
+usage: plot_simulation.py --scenario FILE|NAME --traj traj.csv --metrics metrics.csv
                           [--out-dir output] [--prefix NAME]
 """
 import argparse
@@ -11,10 +13,11 @@ import sys
 # The package is importable once devel/setup.bash is sourced; this also finds it in a checkout.
 sys.path.append(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "src"))
 from variational_formation import data, plots  # noqa: E402
+from variational_formation.cli import description, fail  # noqa: E402
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=description(__doc__))
     parser.add_argument("--scenario", required=True)
     parser.add_argument("--traj", required=True)
     parser.add_argument("--metrics", required=True)
@@ -22,8 +25,10 @@ def main():
     parser.add_argument("--prefix", default=None)
     args = parser.parse_args()
     scenario = data.read_scenario(args.scenario)
-    q = data.read_trajectory(args.traj, scenario.n)
+    q = data.read_trajectory(args.traj, scenario.n, scenario.dimension, f"the scenario {scenario.name}")
     m = data.read_metrics(args.metrics)
+    if len(m.t) != q.shape[0]:
+        fail(f"{args.metrics}: {len(m.t)} steps, {args.traj}: {q.shape[0]}: they do not belong together")
     h = m.t[1] - m.t[0] if len(m.t) > 1 else 1.0
     prefix = args.prefix or scenario.name or "run"
     paths = plots.plot_all(args.out_dir, prefix, prefix, m.t, q, scenario.dimension, m.energy, m.error,

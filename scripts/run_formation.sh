@@ -18,7 +18,9 @@ for a in "$@"; do
   esac
 done
 name="$(basename "$scenario" .yaml)"
-result="$output_dir/$name.result.yaml"
+# Under ROS_NAMESPACE=a/b the formation is /a/b/formation and its files start with "a_b_".
+ns="${ROS_NAMESPACE:-}"; ns="${ns#/}"; ns="${ns%/}"; prefix="${ns//\//_}"
+result="$output_dir/${prefix:+${prefix}_}$name.result.yaml"
 rm -f "$result"
 roslaunch variational_formation formation.launch "$@"
 status=$?

@@ -10,6 +10,7 @@
 
 #include "variational_formation/core/number_checks.hpp"
 #include "variational_formation/ros/markers.hpp"
+#include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/participants.hpp"
 #include "variational_formation/ros/service_call.hpp"
@@ -37,7 +38,7 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   markerEvery_ = optionalParam(pnh, "marker_every", 1);
   if (markerEvery_ < 1) throw InvalidInput("~marker_every: must be >= 1, got " + std::to_string(markerEvery_));
   const std::string recorder = optionalParam<std::string>(pnh, "recorder", "");
-  resultFile_ = optionalParam<std::string>(pnh, "result_file", "");
+  resultFile_ = outputPath(nh, optionalParam<std::string>(pnh, "result_file", ""));
   waitForViewer_ = optionalParam(pnh, "wait_for_viewer", false);
   respawnTimeout_ = optionalParam(pnh, "respawn_timeout", 0.0);
   managers_ = agentManagers(nh, pnh);
@@ -59,6 +60,7 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   trails_.resize(static_cast<std::size_t>(n));
   if (!resultFile_.empty()) {
     createParentDirectory(resultFile_, "~result_file");
+    announceReplacedResult(resultFile_);
     std::ofstream probe(resultFile_);
     if (!probe) throw InvalidInput("~result_file: cannot write '" + resultFile_ + "'");
     probe << "result: running\n";

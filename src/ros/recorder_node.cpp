@@ -6,6 +6,7 @@
 #include <ros/callback_queue.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/participants.hpp"
 #include "variational_formation/ros/service_call.hpp"
@@ -24,7 +25,7 @@ ros::Time bagTime(const ros::Time& stamp) { return std::max(stamp, ros::TIME_MIN
 
 RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), states_(1, 1) {
   const Scenario scenario = loadScenario(requiredParam<std::string>(pnh, "scenario"));
-  path_ = requiredParam<std::string>(pnh, "bag");
+  path_ = outputPath(nh, requiredParam<std::string>(pnh, "bag"));
   monitor_ = participantName(nh, optionalParam<std::string>(pnh, "monitor", "monitor"));
   managers_ = agentManagers(nh, pnh);
   markerEvery_ = optionalParam(pnh, "marker_every", 1);
@@ -40,6 +41,7 @@ RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh),
   splitBytes_ = splitMb * 1e6;
   maxBytes_ = maxMb * 1e6;
   createParentDirectory(path_, "~bag");
+  replaceEarlierBag(path_);
   openPart();
   const std::string prefix = framePrefix(nh);
   statusTopic_ = nh.resolveName("status");

@@ -14,13 +14,14 @@
 #include "variational_formation/tools/arguments.hpp"
 #include "variational_formation/tools/progress.hpp"
 #include "variational_formation/tools/simulate_cli.hpp"
+#include "variational_formation/tools/scenario_path.hpp"
 
 namespace vf {
 
 namespace {
 
 const char* kUsage =
-    "usage: delay_margin --scenario FILE --out-dir DIR [--kappa K] [--time-step H]\n"
+    "usage: delay_margin --scenario FILE|NAME --out-dir DIR [--kappa K] [--time-step H]\n"
     "           [--steps N] [--max-delay 30] [--delays A B] [--losses P1,P2,...]\n"
     "           [--runs 16] [--perturbation 0.05] [--seed S] [--threshold 0.5] [--threads T]\n"
     "Predicts the delay margin D* (largest D with every D' <= D locally stable; linearised\n"
@@ -67,7 +68,7 @@ int runDelayMarginCli(int argc, const char* const* argv, std::ostream& out, std:
     }
     args.require("--scenario");
     args.require("--out-dir");
-    Scenario scenario = loadScenario(args.text("--scenario"));
+    Scenario scenario = loadScenario(resolveScenario(args.text("--scenario")));
     DelayCampaignSettings settings;
     settings.timeStep = args.has("--time-step") ? args.positiveNumber("--time-step") : scenario.timeStep;
     settings.dampingGain = args.has("--kappa") ? args.number("--kappa") : scenario.dampingGain;

@@ -14,13 +14,14 @@
 #include "variational_formation/tools/arguments.hpp"
 #include "variational_formation/tools/progress.hpp"
 #include "variational_formation/tools/simulate_cli.hpp"
+#include "variational_formation/tools/scenario_path.hpp"
 
 namespace vf {
 
 namespace {
 
 const char* kUsage =
-    "usage: roa --scenario FILE --agent I --x-range A B --y-range C D [--z Z]\n"
+    "usage: roa --scenario FILE|NAME --agent I --x-range A B --y-range C D [--z Z]\n"
     "           --resolution NX NY [--time-step H] [--steps N] [--kappa K]\n"
     "           [--tolerance 0.01] [--speed 0.1] [--threads T] --out roa.csv\n"
     "Region of attraction (paper Section 6.2): for every grid point, agent I starts there at\n"
@@ -121,7 +122,7 @@ int runRoaCli(int argc, const char* const* argv, std::ostream& out, std::ostream
     for (const char* flag : {"--scenario", "--agent", "--x-range", "--y-range", "--resolution", "--out"}) {
       args.require(flag);
     }
-    Scenario scenario = loadScenario(args.text("--scenario"));
+    Scenario scenario = loadScenario(resolveScenario(args.text("--scenario")));
     applyOverrides(scenario, scenarioOverrides(args), /*requireBoundedSteps=*/true);
     for (const std::string& w : scenario.warnings) err << "roa: warning: " << w << '\n';
     const RoaCampaign campaign(scenario, readGrid(args, scenario), readSettings(args, scenario));

@@ -8,13 +8,14 @@
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/simulation.hpp"
 #include "variational_formation/tools/arguments.hpp"
+#include "variational_formation/tools/scenario_path.hpp"
 
 namespace vf {
 
 namespace {
 
 const char* kUsage =
-    "usage: simulate --scenario FILE --out traj.csv [--metrics metrics.csv]\n"
+    "usage: simulate --scenario FILE|NAME --out traj.csv [--metrics metrics.csv]\n"
     "                [--method vi|euler|rk4] [--init variational|paper (vi only)]\n"
     "                [--time-step H] [--steps N] [--kappa K]\n"
     "                [--delay-steps D] [--loss P [--seed S]]   (vi only)\n"
@@ -77,7 +78,7 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
     }
     DelaySettings delay;
     const bool delayed = parseDelayFlags(args, method, delay);
-    Scenario scenario = loadScenario(args.text("--scenario"));
+    Scenario scenario = loadScenario(resolveScenario(args.text("--scenario")));
     applyOverrides(scenario, scenarioOverrides(args), /*requireBoundedSteps=*/true);
     for (const std::string& w : scenario.warnings) err << "simulate: warning: " << w << '\n';
 

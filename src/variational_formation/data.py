@@ -3,6 +3,7 @@
 Arrays follow one layout:
   q[k, i, a]   position of agent i at step k (a = x, y, z; z = 0 in 2D) [m]
 """
+import os
 import types
 
 import numpy as np
@@ -27,15 +28,30 @@ def load_csv(path, header):
         fail(f"{path}: {e}")
 
 
-def read_trajectory(path, agents=None):
-    """simulate's traj.csv as q[k, i, 0:3]. `agents` defaults to the count found in the file."""
+def read_trajectory(path, agents=None, dimension=None, scenario_name="the scenario"):
+    """simulate's traj.csv as q[k, i, 0:3]. `agents` defaults to the count found in the file;
+    given (with `dimension`, from the scenario), a file of another formation is an error."""
     rows = load_csv(path, TRAJECTORY_HEADER)
     if rows.shape[0] == 0:
         fail(f"{path}: no rows")
-    n = agents if agents is not None else int(rows[:, 2].max()) + 1
-    if rows.shape[0] % n != 0:
-        fail(f"{path}: {rows.shape[0]} rows is not a multiple of {n} agents")
+    found = int(rows[:, 2].max()) + 1
+    n = agents if agents is not None else found
+    if found != n:
+        fail(f"{path}: the trajectory has {found} agents, {scenario_name} has {n}: they do not belong together")
+    if rows.shape[0] % n != 0 or not np.array_equal(rows[:, 2], np.tile(np.arange(n), rows.shape[0] // n)):
+        fail(f"{path}: rows are not agents 0..{n - 1} step after step")
+    if dimension == 2 and np.any(rows[:, 5] != 0):
+        fail(f"{path}: the trajectory leaves the plane z = 0, {scenario_name} is 2D: they do not belong together")
     return rows[:, 3:6].reshape(rows.shape[0] // n, n, 3)
+
+
+def bag_parts(path):
+    """A bag and the later parts of its recording (<stem>_1.bag, <stem>_2.bag, ...: the
+    recorder's record_split_size), in order."""
+    parts, stem = [path], path[:-len(".bag")] if path.endswith(".bag") else path
+    while os.path.exists(f"{stem}_{len(parts)}.bag"):
+        parts.append(f"{stem}_{len(parts)}.bag")
+    return parts
 
 
 def read_metrics(path):
@@ -44,9 +60,45 @@ def read_metrics(path):
     return types.SimpleNamespace(t=m[:, 1], energy=m[:, 2], error=m[:, 3], p=m[:, 4:7], a=m[:, 7:10])
 
 
-def read_scenario(path):
-    """The fields of a scenario file (already checked by the package's loader) that the plots
-    use: name, dimension, kappa, time_step, n, desired (n x d array) and edges."""
+def scenario_folders():
+    """Where a scenario name is looked up, in the order of the C++ tools (tools/scenario_path.hpp):
+    the package's config/ in each entry of ROS_PACKAGE_PATH, then beside this package: the
+    source checkout (src/variational_formation -> config/) or the install space
+    (<prefix>/lib/python3/dist-packages/variational_formation -> <prefix>/share/.../config)."""
+    folders = []
+    for entry in os.environ.get("ROS_PACKAGE_PATH", "").split(":"):
+        entry = entry.rstrip("/")
+        if entry:
+            package = entry if os.path.basename(entry) == "variational_formation" else os.path.join(
+                entry, "variational_formation")
+            folders.append(os.path.join(package, "config"))
+    here = os.path.dirname(os.path.abspath(__file__))
+    folders.append(os.path.normpath(os.path.join(here, "..", "..", "config")))
+    folders.append(os.path.normpath(os.path.join(here, "..", "..", "..", "..", "share", "variational_formation",
+                                                 "config")))
+    return list(dict.fromkeys(folders))
+
+
+def scenario_path(name_or_path):
+    """The scenario file meant by a --scenario, as the launch files and the C++ tools read it: a
+    path that exists wins; a bare name ("hexagon", "hexagon.yaml") is <name>.yaml in the first of
+    scenario_folders() that has it; another path is returned as it is. fail() if a bare name is
+    found nowhere, listing the places."""
+    if os.path.isfile(name_or_path) or "/" in name_or_path or not name_or_path:
+        return name_or_path
+    file = name_or_path if name_or_path.endswith(".yaml") else name_or_path + ".yaml"
+    folders = scenario_folders()
+    for folder in folders:
+        if os.path.isfile(os.path.join(folder, file)):
+            return os.path.join(folder, file)
+    fail(f"scenario '{name_or_path}': no such file, and no {file} in {', '.join(folders)}")
+
+
+def read_scenario(name_or_path):
+    """The fields of a scenario (a file, or a name: scenario_path) that the plots use, already
+    checked by the package's loader: name, dimension, kappa, time_step, n, desired (n x d
+    array) and edges."""
+    path = scenario_path(name_or_path)
     try:
         with open(path) as f:
             s = yaml.safe_load(f)

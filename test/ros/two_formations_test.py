@@ -21,7 +21,7 @@ class TwoFormations(unittest.TestCase, vf_rostest.RunChecks):
         cls.out = rospy.get_param("~output_dir")
         cls.path = vf_rostest.scenario_path("hexagon")
         cls.scenario = vf_rostest.load_scenario(cls.path)
-        cls.results = {team: vf_rostest.wait_for_result(os.path.join(cls.out, team, "hexagon.result.yaml"), 120.0)
+        cls.results = {team: vf_rostest.wait_for_result(os.path.join(cls.out, team, f"{team}_hexagon.result.yaml"), 120.0)
                        for team in ("team_a", "team_b")}
         cls.expected = vf_rostest.simulate(cls.path)
 
@@ -32,7 +32,7 @@ class TwoFormations(unittest.TestCase, vf_rostest.RunChecks):
     def check_team(self, team, other):
         self.assertEqual(self.results[team].get("result"), "succeeded", f"{team}: {self.results[team]}")
         ns = f"/{team}/formation"
-        rec = vf_rostest.Recording(os.path.join(self.out, team, "hexagon.bag"), ns=ns)
+        rec = vf_rostest.Recording(os.path.join(self.out, team, f"{team}_hexagon.bag"), ns=ns)
         self.check_recording(rec, self.scenario, self.expected, ns=ns)
         self.assertFalse([t for t in rec.topics if t.startswith(f"/{other}/")], "the other team's topics")
         self.assertFalse([f for f in rec.tf if not f.startswith(f"{team}/formation/")], "foreign tf frames")

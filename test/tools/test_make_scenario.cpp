@@ -294,6 +294,14 @@ TEST(MakeScenario, TimeStepAgainstTheStabilityAdvice) {
   EXPECT_NE(warned.err.find("make_scenario: warning: time_step: h = 0.01 exceeds"), std::string::npos)
       << warned.err;
   EXPECT_EQ(makeScenario({"--shape", "ring", "--agents", "10", "--spacing", "100", "--time-step", "0.001"}).err, "");
+  // A step the user chose is theirs, as in every tool that loads a scenario (one warning, the
+  // file written): issue 23's `--time-step 2`.
+  const CliResult chosen = makeScenario({"--shape", "grid", "--rows", "3", "--cols", "3", "--time-step", "2"});
+  EXPECT_EQ(chosen.status, 0) << chosen.err;
+  EXPECT_EQ(std::count(chosen.err.begin(), chosen.err.end(), '\n'), 1) << chosen.err;
+  EXPECT_EQ(chosen.err.rfind("make_scenario: warning: time_step: h = 2 exceeds the linear stability limit", 0), 0u)
+      << chosen.err;
+  EXPECT_NE(chosen.out.find("\ntime_step: 2\n"), std::string::npos) << chosen.out;
 }
 
 void expectBadInput(const std::vector<std::string>& args, const std::string& fragment) {

@@ -1,0 +1,30 @@
+#pragma once
+
+#include <string>
+
+#include <ros/ros.h>
+
+namespace vf {
+
+/**
+ * The file-name prefix of the formation in the namespace of `nh`: the namespace that holds it,
+ * '/' as '_', then '_' ("team_a_" for /team_a/formation, "" for /formation or the root), so
+ * that formations side by side never share an output file.
+ */
+std::string namespaceFilePrefix(const ros::NodeHandle& nh);
+
+/// `path` with every "{ns}" replaced by namespaceFilePrefix(nh) (the ~result_file and ~bag of
+/// formation.launch are "<output_dir>/{ns}<name>...").
+std::string outputPath(const ros::NodeHandle& nh, const std::string& path);
+
+/// One ROS_WARN line if `path` holds the result of an earlier run that this run replaces; a
+/// file saying "result: running" is this run's own (written before a respawn), not a result.
+void announceReplacedResult(const std::string& path);
+
+/**
+ * Before a new recording to `path`: one ROS_WARN line naming the earlier bag this replaces, and
+ * its later parts (<stem>_1.bag, ...) removed, which would otherwise read as this recording's.
+ */
+void replaceEarlierBag(const std::string& path);
+
+}  // namespace vf
