@@ -34,6 +34,7 @@ TOOLS = ("ffmpeg", "ffprobe", "Xvfb", "rviz", "rosbag", "rosmaster")
 MARKERS = "/formation/markers"  # the topic config/formation.rviz shows, below a team's namespace
 TF_SCALE = 8.0  # tf axes and names: this many sphere radii
 FIT_DISTANCE = 3.0  # camera distance over the formation's reach (half the box's diagonal)
+WARM_UP = 1.0  # seconds rviz gets to draw the first instant before the replay goes on
 LATENCY_MAX = 1.0  # seconds rviz may take to draw what it receives
 STARTUP_TIMEOUT = 60.0  # seconds for the master, the display, rviz and the capture to come up
 
@@ -157,19 +158,37 @@ def choose_topics(contents, ns):
         prefix = "/" + ns.strip("/") if ns.strip("/") else ""
         if prefix not in teams:
             fail(f"--ns {ns}: the bag holds no {prefix}/formation/... topics (teams in it: "
-                 f"{', '.join(t or '/' for t in teams) or 'none'})")
+                 f"{', '.join(t or '/ (no namespace)' for t in teams) or 'none'})")
     elif len(teams) > 1:
         fail(f"the bag holds several teams ({', '.join(t or '/' for t in teams)}): choose one with --ns")
     else:
         prefix = teams[0] if teams else ""
     markers = prefix + MARKERS if prefix + MARKERS in contents.topics else None
-    odometry = sorted(t for t, kind in contents.topics.items()
-                      if kind == "nav_msgs/Odometry" and t.startswith(prefix + "/formation/"))
+    # The robots' odometry (robots.launch), shown only where the bag has no markers to show.
+    odometry = [] if markers else sorted(t for t, kind in contents.topics.items()
+                                         if kind == "nav_msgs/Odometry" and t.startswith(prefix + "/formation/"))
     replay = [t for t in (markers, "/tf", "/tf_static") if t in contents.topics] + odometry
     if not markers and "/tf" not in contents.topics and not odometry:
         fail(f"nothing in the bag that rviz shows: no {prefix}{MARKERS}, /tf or robot odometry "
              f"(topics: {', '.join(sorted(contents.topics))})")
     return prefix, markers, odometry, replay
+
+
+def first_instant(contents, topics, first):
+    """How many of the replayed messages share the earliest bag time from `first` on, and the bag
+    time that follows it (None if there is none)."""
+    import rosbag
+    import rospy
+    times = []
+    for path in contents.parts:
+        with rosbag.Bag(path) as bag:
+            for k, (_, _, t) in enumerate(bag.read_messages(topics=topics, start_time=rospy.Time.from_sec(first))):
+                times.append(t.to_sec())
+                if k > 1000 or t.to_sec() > times[0]:
+                    break
+    times.sort()
+    later = [t for t in times if t > times[0]] if times else []
+    return times.count(times[0]) if times else 0, later[0] if later else None
 
 
 class Scene:
@@ -217,15 +236,12 @@ def rviz_config(template, markers, odometry, scene, args):
             # Axes and names that stick out of the agents' spheres: the spheres' radius is a tenth
             # of the shortest desired distance.
             display["Marker Scale"] = round(TF_SCALE * scene.radius, 3)
-    if not markers:
-        for k, topic in enumerate(odometry):
-            manager["Displays"].append({
-                "Class": "rviz/Odometry", "Enabled": True, "Name": topic, "Topic": topic, "Keep": 1,
-                "Position Tolerance": 0.0, "Angle Tolerance": 0.0, "Shape": {"Value": "Arrow", "Color": palette(k),
-                                                                             "Alpha": 1, "Shaft Length": 0.6,
-                                                                             "Shaft Radius": 0.08, "Head Length": 0.25,
-                                                                             "Head Radius": 0.18},
-                "Covariance": {"Value": False}, "Value": True})
+    for k, topic in enumerate(odometry):
+        manager["Displays"].append({
+            "Class": "rviz/Odometry", "Enabled": True, "Name": topic, "Topic": topic, "Keep": 1,
+            "Position Tolerance": 0.0, "Angle Tolerance": 0.0, "Covariance": {"Value": False}, "Value": True,
+            "Shape": {"Value": "Arrow", "Color": palette(k), "Alpha": 1, "Shaft Length": 0.6, "Shaft Radius": 0.08,
+                      "Head Length": 0.25, "Head Radius": 0.18}})
     if scene.fixed_frame:
         manager["Global Options"]["Fixed Frame"] = scene.fixed_frame
     manager["Global Options"]["Frame Rate"] = args.fps
@@ -277,8 +293,10 @@ class Processes:
                 lines = [l.strip() for l in f.read().replace("\r", "\n").splitlines() if l.strip()]
         except OSError:
             return ""
+        # Without X's "(EE)" marks, colours, and the librospack line rviz prints at every start.
+        lines = [re.sub(r"\(EE\)|\x1b\[[0-9;]*m", "", l).strip() for l in lines if "librospack" not in l]
         fatal = [l for l in lines if re.search(r"fatal|error|cannot|could not|failed", l, re.I)]
-        return (fatal or lines or [""])[-1][:200]
+        return (fatal or [l for l in lines if l] or [""])[-1][:200]
 
     def stop(self, p, first_signal=signal.SIGTERM, timeout=5.0):
         """Stops p's process group: first_signal, then SIGKILL after `timeout` seconds."""
@@ -382,6 +400,8 @@ def wait_for_rviz(procs, rviz, master, topics):
 
 def check_alive(procs, p, name):
     if p.poll() is not None:
+        if p.returncode < 0:
+            raise RenderError(f"{name} died (killed by {signal.Signals(-p.returncode).name})")
         raise RenderError(f"{name} died (exit status {p.returncode}): {procs.log_tail(name)}")
 
 
@@ -389,7 +409,7 @@ def start_capture(procs, display, width, height, fps, path):
     """ffmpeg grabbing the display to a lossless file whose timestamps are wall-clock time."""
     cmd = ["ffmpeg", "-nostdin", "-hide_banner", "-loglevel", "error", "-f", "x11grab", "-draw_mouse", "0",
            "-framerate", str(fps), "-video_size", f"{width}x{height}", "-i", display + ".0",
-           "-copyts", "-c:v", "libx264rgb", "-preset", "ultrafast", "-qp", "0", "-y", path]
+           "-copyts", "-c:v", "libx264rgb", "-preset", "ultrafast", "-qp", "0", "-flush_packets", "1", "-y", path]
     capture = procs.start("capture", cmd)
     deadline = time.time() + STARTUP_TIMEOUT
     while not (os.path.exists(path) and os.path.getsize(path) > 0):
@@ -400,17 +420,56 @@ def start_capture(procs, display, width, height, fps, path):
     return capture
 
 
-def replay(procs, args, first, span, topics, env, rviz, capture, progress):
-    """rosbag play --clock of `span` seconds of the bag from bag time `first`; returns the wall-clock
-    time its playback started.
+def start_player(procs, args, first, span, topics, env, rviz):
+    """rosbag play of `span` seconds of the bag from bag time `first`, paused at its first message
+    once rviz has connected to every topic it plays."""
+    cmd = ["rosbag", "play", "--clock", "--pause", "--rate", repr(args.speed), "--start", repr(args.start),
+           "--duration", repr(span), "--wait-for-subscribers", "--delay", "0.5"] + args.bags + ["--topics"] + topics
+    player = procs.start("play", cmd, env=env, stdout=subprocess.PIPE, stdin=subprocess.PIPE)
+    read_until(procs, player, rviz, b"[PAUSED", STARTUP_TIMEOUT)
+    return player
 
-    rosbag play maps bag time to wall time once, at its start: bag time t is published at
-    W0 + (t - t0) / speed. Each of its progress lines (bag time t seen at wall time w, a little
-    after it was printed) bounds W0 from above, and the smallest bound is the closest."""
-    cmd = ["rosbag", "play", "--clock", "--rate", repr(args.speed), "--start", repr(args.start),
-           "--duration", repr(span), "--wait-for-subscribers", "--delay", "0.5"]
-    cmd += args.bags + ["--topics"] + topics
-    player = procs.start("play", cmd, env=env, stdout=subprocess.PIPE)
+
+def read_until(procs, player, rviz, pattern, timeout, times=1):
+    """Reads rosbag play's output until `pattern` appears `times` times in what it prints from now on."""
+    deadline, buffered = time.time() + timeout, b""
+    while buffered.count(pattern) < times:
+        ready, _, _ = select.select([player.stdout], [], [], 0.2)
+        chunk = os.read(player.stdout.fileno(), 4096) if ready else b""
+        if ready and not chunk:
+            player.wait()
+            raise RenderError(f"rosbag play failed (exit status {player.returncode}): {procs.log_tail('play')}")
+        buffered = (buffered + chunk)[-16384:]
+        check_alive(procs, rviz, "rviz")
+        if time.time() > deadline:
+            raise RenderError(f"rosbag play did not answer within {timeout:.0f} s")
+
+
+def warm_up(procs, player, rviz, messages):
+    """Steps the paused player through the first instant's messages (an 's' on its stdin each, as
+    on a terminal) and gives rviz WARM_UP seconds to build its scene: the first picture it draws
+    takes it far longer than the next ones, and the video would miss the run's start."""
+    for _ in range(messages):
+        player.stdin.write(b"s")
+        player.stdin.flush()
+        # Paused, it prints a line every 0.1 s after reading its stdin: the second line after
+        # the 's' comes after the step (one character per step: the rest would wait in its buffer).
+        read_until(procs, player, rviz, b"[PAUSED", 10.0, times=2)
+    deadline = time.time() + WARM_UP
+    while time.time() < deadline:
+        check_alive(procs, rviz, "rviz")
+        time.sleep(0.05)
+
+
+def replay(procs, args, player, first, span, rviz, capture, progress):
+    """Resumes the paused player (a space on its stdin) and follows it to its end; returns the
+    wall-clock time of bag time `first`.
+
+    rosbag play maps bag time to wall time when it resumes: bag time t is published at
+    W0 + (t - first) / speed. Each of its progress lines (bag time t, read at wall time w, a
+    little after it was printed) bounds W0 from above, and the smallest bound is the closest."""
+    player.stdin.write(b" ")
+    player.stdin.flush()
     started, buffered = float("inf"), b""
     bag_time = re.compile(rb"\[RUNNING\]\s+Bag Time:\s+([0-9.]+)")
     while True:
@@ -451,20 +510,28 @@ def encode(capture_path, offset, duration, outs, fps):
             raise RenderError(f"ffmpeg could not write {out}: {lines[-1] if lines else 'exit status %d' % result.returncode}")
 
 
-def display_latency(path, offset, width, height, fps):
-    """Seconds from the replay's start to the first captured frame that differs from the picture
-    before it (rviz draws what it receives a few frames late); 0 if none does within LATENCY_MAX."""
+def first_drawn(path, capture_start, since, width, height):
+    """Wall-clock time of the first captured frame from `since` on that differs from the picture
+    before `since`; `since` itself if none does within LATENCY_MAX."""
     import numpy as np
-    before = 2.0 / fps
-    cmd = ["ffmpeg", "-nostdin", "-v", "error", "-ss", f"{max(0.0, offset - before):.3f}", "-i", path, "-t",
-           f"{before + LATENCY_MAX:.3f}", "-f", "rawvideo", "-pix_fmt", "gray", "-"]
+    cmd = ["ffmpeg", "-nostdin", "-hide_banner", "-loglevel", "info", "-ss", f"{max(0.0, since - capture_start - 0.5):.3f}",
+           "-t", f"{LATENCY_MAX + 0.5:.3f}", "-i", path, "-copyts", "-vf", "showinfo", "-f", "rawvideo", "-pix_fmt",
+           "gray", "-"]
     result = subprocess.run(cmd, capture_output=True, start_new_session=True)
+    # showinfo's pts_time is rounded; pts is exact, in the time base it states first.
+    base = re.search(rb"time_base:\s*(\d+)/(\d+)", result.stderr)
+    if not base:
+        return since
+    stamps = [int(t) * int(base[1]) / int(base[2]) for t in re.findall(rb"\bn:\s*\d+\s+pts:\s*(\d+)", result.stderr)]
     frames = np.frombuffer(result.stdout, dtype=np.uint8)
-    frames = frames[:frames.size // (width * height) * width * height].reshape(-1, width, height)
-    if len(frames) < 2:
-        return 0.0
-    changed = [k for k in range(1, len(frames)) if np.any(frames[k] != frames[0])]
-    return max(0.0, changed[0] / fps - before) if changed else 0.0
+    count = min(len(stamps), frames.size // (width * height))
+    frames = frames[:count * width * height].reshape(count, height, width)
+    before = [k for k in range(count) if stamps[k] < since]
+    if not before:
+        return since
+    reference = frames[before[-1]]
+    drawn = [stamps[k] for k in range(before[-1] + 1, count) if np.any(frames[k] != reference)]
+    return drawn[0] if drawn else since
 
 
 def capture_start(path):
@@ -505,10 +572,13 @@ def render(args, procs, tmp, progress):
     env["DISPLAY"] = display
     rviz = procs.start("rviz", ["rviz", "-d", config, "--fullscreen", "__name:=render_rviz"], env=env)
     wait_for_rviz(procs, rviz, master, [t for t in topics if t != "/tf_static"])
+    player = start_player(procs, args, first, span, topics, env, rviz)
     timings = {"start-up": time.time()}
     capture_path = os.path.join(tmp, "capture.mkv")
     capture = start_capture(procs, display, args.width, args.height, args.fps, capture_path)
-    started = replay(procs, args, first, span, topics, env, rviz, capture, progress)
+    count, second = first_instant(contents, topics, first)
+    warm_up(procs, player, rviz, count)
+    started = replay(procs, args, player, first, span, rviz, capture, progress)
     # One frame more than the span: the last frame shows the span's last message.
     played = span / args.speed + 1.0 / args.fps
     # The capture must hold the last picture, drawn up to LATENCY_MAX late.
@@ -518,9 +588,15 @@ def render(args, procs, tmp, progress):
     if capture.returncode not in (0, 255, -signal.SIGINT):
         raise RenderError(f"ffmpeg's capture failed (exit status {capture.returncode}): {procs.log_tail('capture')}")
     timings["replay"] = time.time()
-    offset = started - capture_start(capture_path)
     progress(None)
-    offset += display_latency(capture_path, offset, args.width, args.height, args.fps)
+    start_time = capture_start(capture_path)
+    # rviz draws late: the first change on screen after the replay resumed shows the second
+    # instant, published (second - first) / speed after it. The video starts that much earlier,
+    # on the picture of the first instant, half a frame early so that the seek keeps it.
+    shown = (second - first) / args.speed if second is not None else 0.0
+    latency = min(LATENCY_MAX, max(0.0, first_drawn(capture_path, start_time, started + shown, args.width, args.height)
+                                   - started - shown))
+    offset = started + latency - start_time - 0.5 / args.fps
     encode(capture_path, max(0.0, offset), played, args.out, args.fps)
     timings["encoding"] = time.time()
     return args.start, args.start + span, played, timings
