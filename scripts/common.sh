@@ -18,7 +18,7 @@ VF_APT_PACKAGES=(
   ros-geometry-msgs ros-visualization-msgs ros-std-msgs ros-message-generation ros-message-runtime
   ros-tf2-msgs librosbag-dev python3-rosbag python3-rostest librostest-dev python3-roslaunch
   rosbash rviz libeigen3-dev libyaml-cpp-dev libgtest-dev googletest libbenchmark-dev
-  python3-matplotlib python3-numpy python3-yaml xvfb x11-apps python3-tf2-ros
+  python3-matplotlib python3-numpy python3-yaml xvfb x11-apps ffmpeg python3-tf2-ros
   python3-rosparam python3-rospkg ros-nav-msgs libnav-msgs-dev python3-nav-msgs python3-setuptools
   python3-rosunit iproute2
   libdiagnostic-updater-dev python3-dynamic-reconfigure libdynamic-reconfigure-config-init-mutex-dev
