@@ -9,7 +9,9 @@ with ffmpeg (x11grab). The video lasts (to - from) / speed seconds. A bag split 
 stopped when it ends, also on Ctrl-C or SIGTERM.
 
 usage: render_bag.py BAG [BAG ...] [--out FILE.mp4 [FILE.gif]] [--speed S] [--size WxH]
-                     [--fps N] [--from SEC] [--to SEC] [--ns NAMESPACE]
+                     [--fps N] [--from SEC] [--to SEC] [--ns NAMESPACE] [--camera fit|config]
+                     [--display :N] [--port P]
+Details: doc/render.md.
 """
 import argparse
 import os
@@ -30,7 +32,8 @@ sys.path.append(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "
 from variational_formation.cli import fail  # noqa: E402
 
 FORMATS = (".mp4", ".gif")
-TOOLS = ("ffmpeg", "ffprobe", "Xvfb", "rviz", "rosbag", "rosmaster")
+TOOLS = {"ffmpeg": "ffmpeg", "ffprobe": "ffmpeg", "Xvfb": "xvfb", "rviz": "rviz", "rosbag": "python3-rosbag",
+         "rosmaster": "python3-rosmaster"}  # each with its Debian package
 MARKERS = "/formation/markers"  # the topic config/formation.rviz shows, below a team's namespace
 TF_SCALE = 8.0  # tf axes and names: this many sphere radii
 FIT_DISTANCE = 3.0  # camera distance over the formation's reach (half the box's diagonal)
@@ -48,7 +51,7 @@ class Interrupted(Exception):
 
 
 def parse_args():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] + " " + __doc__.splitlines()[1])
+    parser = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
     parser.add_argument("bags", nargs="+", metavar="BAG",
                         help="a bag of formation.launch record:=true or robots.launch record:=true; the other "
                              "parts of a split bag are found next to its first one")
@@ -96,10 +99,9 @@ def parse_args():
         directory = os.path.dirname(os.path.abspath(out))
         if not os.path.isdir(directory):
             fail(f"--out: the directory of '{out}' does not exist")
-    for tool in TOOLS:
+    for tool, package in TOOLS.items():
         if shutil.which(tool) is None:
-            fail(f"{tool} is not installed or not on PATH (Debian: apt-get install "
-                 f"{'ffmpeg' if tool.startswith('ff') else 'xvfb' if tool == 'Xvfb' else 'rviz' if tool == 'rviz' else 'ros-base'})")
+            fail(f"{tool} is not installed or not on PATH (Debian: apt-get install {package})")
     return args
 
 
