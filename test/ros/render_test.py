@@ -4,9 +4,10 @@ the same launch and split in parts (hexagon.bag, hexagon_1.bag, ...), into an MP
 
 Checks, on both videos: ffprobe's duration is the run's (4.2 s) over the speed, within 10%, at
 the asked size; no frame is blank; the last frame shows every agent's colour; the first and last
-frames differ. No process the render started outlives it, after a good run, after Ctrl-C, or after
-a failure. Bad inputs get one line on stderr and a non-zero status: no bag, an empty bag, no
-ffmpeg on PATH, a display that cannot start (taken by another X server), rviz that dies.
+frames differ. A namespaced team's bag renders with --ns. No process the render started outlives
+it, after a good run, after Ctrl-C, or after a failure. Bad inputs get one line on stderr and a
+non-zero status: no bag, an empty bag, no ffmpeg on PATH, a display that cannot start (taken by
+another X server), rviz that dies.
 
 VF_TEST_DISPLAY=:N (optional) makes every render use X display :N, and the busy-display case
 N + 1; by default Xvfb picks free ones.
@@ -185,6 +186,32 @@ class RenderTest(unittest.TestCase):
         # The formation settles and its edges turn from red to green: measured 5% of the pixels.
         changed = np.abs(frames[0].astype(int) - frames[-1].astype(int)).max(axis=2) > 30
         self.assertGreater(changed.mean(), 0.01, "the first and last frames are nearly the same")
+
+    def test_namespaced_team(self):
+        # The hexagon's bag as a team under <group ns="team_a"> records it: topics /team_a/formation/...
+        # and frames team_a/formation/agent_<i> (rewritten here rather than run again).
+        import rosbag
+        bag = os.path.join(self.tmp, "team_a_hexagon.bag")
+        with rosbag.Bag(bag, "w") as out:
+            for part in [self.bag] + [f"{self.bag[:-len('.bag')]}_{k}.bag" for k in range(1, 100)]:
+                if not os.path.exists(part):
+                    break
+                with rosbag.Bag(part) as recorded:
+                    for topic, msg, t in recorded.read_messages():
+                        if topic == "/tf":
+                            for transform in msg.transforms:
+                                transform.child_frame_id = "team_a/" + transform.child_frame_id
+                        out.write(topic if topic == "/tf" else "/team_a" + topic, msg, t)
+        self.assert_one_line_error(self.render(bag, "--ns", "team_b").finish(), 2, ["--ns team_b", "/team_a"])
+        video = os.path.join(self.tmp, "team_a.mp4")
+        code, _, err = self.render(bag, "--ns", "team_a", "--out", video, "--speed", "4", "--fps", "10",
+                                   "--size", "320x240").finish()
+        self.assertEqual(code, 0, err)
+        raw = subprocess.run(["ffmpeg", "-v", "error", "-sseof", "-0.3", "-i", video, "-f", "rawvideo", "-pix_fmt",
+                              "rgb24", "-"], capture_output=True, check=True).stdout
+        last = np.frombuffer(raw, dtype=np.uint8).reshape(-1, 240, 320, 3)[-1]
+        for rgb, count in zip(vf_rostest.PALETTE, vf_rostest.agent_colour_pixels(last / 255.0)):
+            self.assertGreater(count, 5, f"an agent's colour {rgb} is not in the team's last frame")
 
     def test_ctrl_c_stops_everything(self):
         watched = self.render(self.bag, "--out", os.path.join(self.tmp, "stopped.mp4"), "--speed", "0.25",
