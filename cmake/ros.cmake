@@ -68,6 +68,8 @@ if(CATKIN_ENABLE_TESTING)
   endforeach()
   add_rostest(test/ros/timed_bad_input.test)
   add_rostest(test/ros/robots_run.test)
+  # render_bag.py on a recorded hexagon: video length, frames, processes left, bad inputs.
+  add_rostest(test/ros/render.test)
   # SIGKILL to the nodelet manager of every agent during a recorded run: test/ros/nodelet_fault.test.
   add_rostest(test/ros/nodelet_fault.test ARGS seed:=3)
   foreach(t two_formations two_teams launch)

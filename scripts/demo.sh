@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The main job: installs and builds if needed, runs a scenario (default: the tetrahedron) as a
 # distributed ROS run through roslaunch, headless, recording everything rviz would show to
-# output/<scenario>.bag, then plots from the bag into output/ and prints a summary.
+# output/<scenario>.bag, then plots from the bag into output/, prints a summary, and renders the
+# bag as rviz shows it to output/<scenario>.mp4 (render_bag.py: Xvfb, rviz and ffmpeg).
 # usage: ./scripts/demo.sh [scenario]      (a name in config/ or a path)
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 scenario="${1:-tetrahedron}"
@@ -20,4 +21,6 @@ echo "running $name: one agent node per agent, the monitor and the recorder (ros
 grep -E "monitor: .*steps in|congruent with" "$out/$name.launch.log" | sed -E 's/^.*\]: //; s/\x1b\[[0-9;]*m//g'
 /usr/bin/python3 "$REPO/scripts/plot_bag.py" --bag "$out/$name.bag" --scenario "$cfg" --out-dir "$out" \
   --prefix "$name"
+/usr/bin/python3 "$REPO/scripts/render_bag.py" "$out/$name.bag" --out "$out/$name.mp4" || {
+  echo "demo: the video could not be rendered (the run, the bag and the plots are fine)" >&2; exit 1; }
 echo "bag: $out/$name.bag (replay: rosbag play $out/$name.bag with rviz -d config/formation.rviz)"

@@ -19,7 +19,6 @@ subprocesses, on the test's master), with real faults.
 - An unbounded recorded run with a small size limit splits its bag and stops recording at the
   limit, while the run goes on.
 """
-import colorsys
 import csv
 import os
 import re
@@ -46,9 +45,6 @@ import vf_rostest  # noqa: E402
 
 PKG = vf_rostest.PKG
 SCENARIO = "hexagon"
-# Agent colours of src/ros/markers.cpp (agentColour), for the agents of the hexagon.
-PALETTE = [(0.90, 0.10, 0.10), (0.10, 0.45, 0.90), (0.10, 0.75, 0.20), (0.95, 0.60, 0.05),
-           (0.60, 0.20, 0.80), (0.05, 0.80, 0.80)]
 
 
 def run_formation(*args, timeout=120):
@@ -389,12 +385,8 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
                 except subprocess.TimeoutExpired:
                     p.kill()
         image = matplotlib.image.imread(png)[:, :, :3]
-        hsv = matplotlib.colors.rgb_to_hsv(image)
-        for i, rgb in enumerate(PALETTE):
-            hue = colorsys.rgb_to_hsv(*rgb)[0]
-            distance = np.minimum(abs(hsv[:, :, 0] - hue), 1 - abs(hsv[:, :, 0] - hue))
-            matches = (distance < 0.02) & (hsv[:, :, 1] > 0.5) & (hsv[:, :, 2] > 0.25)
-            self.assertGreater(int(matches.sum()), 30, f"agent {i}'s colour {rgb} is not in the screenshot")
+        for rgb, count in zip(vf_rostest.PALETTE, vf_rostest.agent_colour_pixels(image)):
+            self.assertGreater(count, 30, f"an agent's colour {rgb} is not in the screenshot")
 
 
 def rospkg_path():

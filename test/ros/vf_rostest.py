@@ -73,6 +73,27 @@ def wait_for_result(path, timeout):
         time.sleep(0.2)
 
 
+# The agents' colours in the markers (src/ros/markers.cpp, agentColour), as RGB in [0, 1].
+PALETTE = [(0.90, 0.10, 0.10), (0.10, 0.45, 0.90), (0.10, 0.75, 0.20), (0.95, 0.60, 0.05),
+           (0.60, 0.20, 0.80), (0.05, 0.80, 0.80)]
+
+
+def agent_colour_pixels(image):
+    """Per colour of PALETTE, how many pixels of an RGB image in [0, 1] have its hue, saturated
+    and bright enough to be a sphere or trail drawn by rviz."""
+    import colorsys
+
+    import matplotlib.colors
+    import numpy as np
+    hsv = matplotlib.colors.rgb_to_hsv(image[:, :, :3])
+    counts = []
+    for rgb in PALETTE:
+        hue = colorsys.rgb_to_hsv(*rgb)[0]
+        distance = np.minimum(abs(hsv[:, :, 0] - hue), 1 - abs(hsv[:, :, 0] - hue))
+        counts.append(int(((distance < 0.02) & (hsv[:, :, 1] > 0.5) & (hsv[:, :, 2] > 0.25)).sum()))
+    return counts
+
+
 class Recording:
     """Everything a bag of formation.launch record:=true holds, by agent and step."""
 

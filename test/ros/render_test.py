@@ -1,0 +1,277 @@
+#!/usr/bin/python3
+"""rostest (render.test): render_bag.py turns the hexagon's bag, recorded by formation.launch in
+the same launch and split in parts (hexagon.bag, hexagon_1.bag, ...), into an MP4 and a GIF.
+
+Checks, on both videos: ffprobe's duration is the run's (4.2 s) over the speed, within 10%, at
+the asked size; no frame is blank; the last frame shows every agent's colour; the first and last
+frames differ. A namespaced team's bag renders with --ns. No process the render started outlives
+it, after a good run, after Ctrl-C, or after a failure. Bad inputs get one line on stderr and a
+non-zero status: no bag, an empty bag, no ffmpeg on PATH, a display that cannot start (taken by
+another X server), rviz that dies.
+
+VF_TEST_DISPLAY=:N (optional) makes every render use X display :N, and the busy-display case
+N + 1; by default Xvfb picks free ones.
+
+Private parameters:
+  output_dir   where formation.launch writes the bag and the result file (removed after)
+"""
+import os
+import select
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import unittest
+
+import numpy as np
+import roslib.packages
+import rospy
+import rostest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import vf_rostest  # noqa: E402
+
+PKG = vf_rostest.PKG
+RUN_SECONDS = 4.2  # config/hexagon.yaml: 300 steps of 0.014 s
+SPEED, FPS, WIDTH, HEIGHT = 2.0, 20, 640, 480
+# Standard deviation of the pixel values (0..255) of a frame: measured 12.5 for rviz's empty grid
+# at this size, 21 to 23 with the hexagon drawn.
+BLANK_STD = 17.0
+TOOLS = ("Xvfb", "rviz", "rosbag", "rosmaster", "ffprobe")  # render_bag.py's tools but ffmpeg
+
+
+def render_bag():
+    return roslib.packages.find_node(PKG, "render_bag.py")[0]
+
+
+def test_display(offset=0):
+    display = os.environ.get("VF_TEST_DISPLAY")
+    return f":{int(display.lstrip(':')) + offset}" if display else None
+
+
+def proc_stat(pid):
+    """(parent pid, process group, start time) of a live process, or None."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            fields = f.read().rsplit(")", 1)[1].split()
+        return int(fields[1]), int(fields[2]), int(fields[19])
+    except (OSError, IndexError, ValueError):
+        return None
+
+
+class Watched:
+    """A render_bag.py process and every process it starts, seen by polling /proc every 0.1 s
+    (the render's processes live for seconds)."""
+
+    def __init__(self, args, env=None):
+        self.proc = subprocess.Popen(["/usr/bin/python3", render_bag()] + args, env=env, stdin=subprocess.DEVNULL,
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.seen = {}  # pid: (process group, start time, command line)
+        self.done = threading.Event()
+        self.thread = threading.Thread(target=self.watch, daemon=True)
+        self.thread.start()
+
+    def watch(self):
+        while not self.done.is_set():
+            family = {self.proc.pid}
+            stats = {}
+            for entry in os.listdir("/proc"):
+                if entry.isdigit():
+                    stat = proc_stat(int(entry))
+                    if stat:
+                        stats[int(entry)] = stat
+            grew = True
+            while grew:
+                grew = False
+                for pid, (parent, _, _) in stats.items():
+                    if parent in family and pid not in family:
+                        family.add(pid)
+                        grew = True
+            for pid in family - {self.proc.pid}:
+                if pid not in self.seen:
+                    try:
+                        with open(f"/proc/{pid}/cmdline") as f:
+                            cmdline = f.read().replace("\0", " ").strip()
+                    except OSError:
+                        cmdline = "?"
+                    self.seen[pid] = (stats[pid][1], stats[pid][2], cmdline)
+            time.sleep(0.1)
+
+    def running(self, word):
+        return any(word in cmd for _, _, cmd in self.seen.values())
+
+    def finish(self, timeout=300):
+        out, err = self.proc.communicate(timeout=timeout)
+        self.done.set()
+        self.thread.join()
+        return self.proc.returncode, out, err
+
+    def left_behind(self):
+        """Processes the render started that still run: by pid (same start time) or process group."""
+        groups = {group for group, _, _ in self.seen.values()} - {os.getpgrp()}
+        left = [cmd for pid, (_, start, cmd) in self.seen.items() if (proc_stat(pid) or (0, 0, -1))[2] == start]
+        for entry in os.listdir("/proc"):
+            stat = proc_stat(int(entry)) if entry.isdigit() else None
+            if stat and stat[1] in groups and int(entry) not in self.seen:
+                left.append(f"pid {entry} in group {stat[1]}")
+        return left
+
+
+class RenderTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("render_test")
+        cls.out = rospy.get_param("~output_dir")
+        cls.result = vf_rostest.wait_for_result(os.path.join(cls.out, "hexagon.result.yaml"), 120.0)
+        cls.bag = os.path.join(cls.out, "hexagon.bag")
+        cls.tmp = tempfile.mkdtemp(prefix="render_test_")
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.out, ignore_errors=True)
+        shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def render(self, *args, env=None):
+        display = test_display()
+        return Watched(list(args) + (["--display", display] if display else []), env=env)
+
+    def assert_nothing_left(self, watched):
+        self.assertTrue(watched.seen, "the render started no process")
+        self.assertEqual(watched.left_behind(), [], "processes of the render still running")
+
+    def assert_one_line_error(self, result, status, words):
+        code, out, err = result
+        self.assertEqual(code, status, f"exit status; stderr: {err}")
+        self.assertEqual(out, "")
+        self.assertEqual(len(err.strip().splitlines()), 1, f"one line on stderr, got: {err}")
+        for word in words:
+            self.assertIn(word, err)
+
+    def setUp(self):
+        self.assertEqual(self.result.get("result"), "succeeded", f"the recorded run: {self.result}")
+
+    def test_videos_of_the_run(self):
+        self.assertTrue(os.path.exists(self.bag[:-len(".bag")] + "_1.bag"), "the recording is not split")
+        outs = [os.path.join(self.tmp, "hexagon.mp4"), os.path.join(self.tmp, "hexagon.gif")]
+        watched = self.render(self.bag, "--out", *outs, "--speed", str(SPEED), "--fps", str(FPS),
+                              "--size", f"{WIDTH}x{HEIGHT}")
+        code, out, err = watched.finish()
+        self.assertEqual(code, 0, err)
+        self.assertEqual(len(out.splitlines()), 1, f"one line on stdout (not a terminal: no progress): {out}")
+        self.assertTrue(out.startswith("render_bag: wrote"), out)
+        self.assert_nothing_left(watched)
+        for path, codec in zip(outs, ("h264", "gif")):
+            with self.subTest(video=os.path.basename(path)):
+                self.check_video(path, codec)
+
+    def check_video(self, path, codec):
+        probe = subprocess.run(["ffprobe", "-v", "error", "-select_streams", "v:0", "-show_entries",
+                                "stream=codec_name,width,height:format=duration", "-of", "default=noprint_wrappers=1",
+                                path], capture_output=True, text=True, check=True).stdout
+        info = dict(line.split("=", 1) for line in probe.split())
+        self.assertEqual((info["codec_name"], int(info["width"]), int(info["height"])), (codec, WIDTH, HEIGHT))
+        self.assertAlmostEqual(float(info["duration"]), RUN_SECONDS / SPEED, delta=0.1 * RUN_SECONDS / SPEED)
+        raw = subprocess.run(["ffmpeg", "-v", "error", "-i", path, "-f", "rawvideo", "-pix_fmt", "rgb24", "-"],
+                             capture_output=True, check=True).stdout
+        frames = np.frombuffer(raw, dtype=np.uint8).reshape(-1, HEIGHT, WIDTH, 3)
+        self.assertGreater(len(frames), 0.9 * FPS * RUN_SECONDS / SPEED)
+        spread = [float(f.std()) for f in frames]
+        blank = [k for k, s in enumerate(spread) if s <= BLANK_STD]
+        self.assertEqual(blank, [], f"blank frames (pixel std <= {BLANK_STD}; lowest {min(spread):.1f})")
+        for rgb, count in zip(vf_rostest.PALETTE, vf_rostest.agent_colour_pixels(frames[-1] / 255.0)):
+            self.assertGreater(count, 30, f"an agent's colour {rgb} is not in the last frame")
+        # The formation settles and its edges turn from red to green: measured 5% of the pixels.
+        changed = np.abs(frames[0].astype(int) - frames[-1].astype(int)).max(axis=2) > 30
+        self.assertGreater(changed.mean(), 0.01, "the first and last frames are nearly the same")
+
+    def test_namespaced_team(self):
+        # The hexagon's bag as a team under <group ns="team_a"> records it: topics /team_a/formation/...
+        # and frames team_a/formation/agent_<i> (rewritten here rather than run again).
+        import rosbag
+        bag = os.path.join(self.tmp, "team_a_hexagon.bag")
+        with rosbag.Bag(bag, "w") as out:
+            for part in [self.bag] + [f"{self.bag[:-len('.bag')]}_{k}.bag" for k in range(1, 100)]:
+                if not os.path.exists(part):
+                    break
+                with rosbag.Bag(part) as recorded:
+                    for topic, msg, t in recorded.read_messages():
+                        if topic == "/tf":
+                            for transform in msg.transforms:
+                                transform.child_frame_id = "team_a/" + transform.child_frame_id
+                        out.write(topic if topic == "/tf" else "/team_a" + topic, msg, t)
+        self.assert_one_line_error(self.render(bag, "--ns", "team_b").finish(), 2, ["--ns team_b", "/team_a"])
+        video = os.path.join(self.tmp, "team_a.mp4")
+        code, _, err = self.render(bag, "--ns", "team_a", "--out", video, "--speed", "4", "--fps", "10",
+                                   "--size", "320x240").finish()
+        self.assertEqual(code, 0, err)
+        raw = subprocess.run(["ffmpeg", "-v", "error", "-sseof", "-0.3", "-i", video, "-f", "rawvideo", "-pix_fmt",
+                              "rgb24", "-"], capture_output=True, check=True).stdout
+        last = np.frombuffer(raw, dtype=np.uint8).reshape(-1, 240, 320, 3)[-1]
+        for rgb, count in zip(vf_rostest.PALETTE, vf_rostest.agent_colour_pixels(last / 255.0)):
+            self.assertGreater(count, 5, f"an agent's colour {rgb} is not in the team's last frame")
+
+    def test_ctrl_c_stops_everything(self):
+        watched = self.render(self.bag, "--out", os.path.join(self.tmp, "stopped.mp4"), "--speed", "0.25",
+                              "--fps", "10", "--size", "320x240")
+        end = time.time() + 120
+        while not watched.running("x11grab") and time.time() < end and watched.proc.poll() is None:
+            time.sleep(0.1)
+        self.assertTrue(watched.running("x11grab"), "the capture never started")
+        time.sleep(3.0)  # into the replay, which lasts 4.2 s / 0.25 = 17 s
+        watched.proc.send_signal(signal.SIGINT)
+        self.assert_one_line_error(watched.finish(), 130, ["interrupted"])
+        self.assert_nothing_left(watched)
+        self.assertFalse(os.path.exists(os.path.join(self.tmp, "stopped.mp4")))
+
+    def test_no_bag(self):
+        missing = os.path.join(self.tmp, "no_such.bag")
+        self.assert_one_line_error(self.render(missing).finish(), 2, [missing, "no such bag"])
+
+    def test_empty_bag(self):
+        import rosbag
+        empty = os.path.join(self.tmp, "empty.bag")
+        rosbag.Bag(empty, "w").close()
+        self.assert_one_line_error(self.render(empty).finish(), 2, [empty, "empty"])
+
+    def test_no_ffmpeg(self):
+        tools = os.path.join(self.tmp, "tools")
+        os.makedirs(tools, exist_ok=True)
+        for tool in TOOLS:
+            target = os.path.join(tools, tool)
+            if not os.path.exists(target):
+                os.symlink(shutil.which(tool), target)
+        env = dict(os.environ, PATH=tools)
+        self.assert_one_line_error(self.render(self.bag, env=env).finish(), 2, ["ffmpeg is not installed"])
+
+    def test_display_that_cannot_start(self):
+        read_end, write_end = os.pipe()
+        wanted = test_display(1)
+        taken = subprocess.Popen(["Xvfb"] + ([wanted] if wanted else []) + ["-nolisten", "tcp", "-displayfd",
+                                                                           str(write_end)],
+                                 pass_fds=(write_end,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        os.close(write_end)
+        try:
+            ready, _, _ = select.select([read_end], [], [], 30)
+            self.assertTrue(ready, "the test's own Xvfb did not start")
+            display = ":" + os.read(read_end, 64).decode().strip()
+            watched = Watched([self.bag, "--out", os.path.join(self.tmp, "x.mp4"), "--display", display])
+            self.assert_one_line_error(watched.finish(), 1, [f"the display {display} cannot start"])
+            self.assert_nothing_left(watched)
+        finally:
+            os.close(read_end)
+            taken.terminate()
+            taken.wait()
+
+    def test_rviz_that_dies(self):
+        # Qt cannot load a platform plugin that does not exist: rviz exits at start.
+        env = dict(os.environ, QT_QPA_PLATFORM="no_such_platform")
+        watched = self.render(self.bag, "--out", os.path.join(self.tmp, "x.mp4"), env=env)
+        self.assert_one_line_error(watched.finish(), 1, ["rviz died"])
+        self.assert_nothing_left(watched)
+
+
+if __name__ == "__main__":
+    rostest.rosrun(PKG, "render_test", RenderTest, sys.argv)
