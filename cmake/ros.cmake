@@ -1,7 +1,7 @@
 # The ROS layer: thin nodes over the core, plus rostests.
 add_library(variational_formation_ros src/ros/agent_node.cpp src/ros/markers.cpp src/ros/monitor_node.cpp
-  src/ros/participants.cpp
   src/ros/output_files.cpp
+  src/ros/participants.cpp
   src/ros/recorder_node.cpp)
 # The time-driven agent (doc/robots.md), selected by the agent's ~mode.
 target_sources(variational_formation_ros PRIVATE src/ros/timed_agent_node.cpp)

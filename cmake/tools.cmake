@@ -5,11 +5,9 @@ add_library(variational_formation_tools
   src/tools/simulate_cli.cpp
 )
 target_link_libraries(variational_formation_tools PUBLIC variational_formation_core)
-# Scenario names (--scenario hexagon) are looked up without ROS too: in the installed share
-# folder and in the source folder of this build (tools/scenario_path.hpp).
+# Scenario names (--scenario hexagon) are looked up without ROS too, beside the running program
+# (tools/scenario_path.hpp): nothing about the build's folders is compiled in.
 target_sources(variational_formation_tools PRIVATE src/tools/scenario_path.cpp)
-set_source_files_properties(src/tools/scenario_path.cpp PROPERTIES COMPILE_DEFINITIONS
-  "VF_INSTALLED_CONFIG_DIR=\"${CMAKE_INSTALL_PREFIX}/${CATKIN_PACKAGE_SHARE_DESTINATION}/config\";VF_SOURCE_CONFIG_DIR=\"${PROJECT_SOURCE_DIR}/config\"")
 target_compile_options(variational_formation_tools PRIVATE ${VF_FLAGS})
 
 add_executable(simulate src/tools/simulate_main.cpp)

@@ -33,8 +33,17 @@ std::vector<std::string> scenarioFolders() {
       add(folders, isPackage ? entry + "/config" : entry + "/variational_formation/config");
     }
   }
-  add(folders, VF_INSTALLED_CONFIG_DIR);
-  add(folders, VF_SOURCE_CONFIG_DIR);
+  // Beside the running program, so that nothing about the build's folders is compiled in (the
+  // install space must not name the workspace): an installed tool lives in
+  // <prefix>/lib/variational_formation beside <prefix>/share/variational_formation, and a devel
+  // one in <ws>/devel/lib/variational_formation beside the sources in <ws>/src.
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const std::filesystem::path prefix = exe.parent_path() / ".." / "..";
+    add(folders, (prefix / "share" / "variational_formation" / "config").lexically_normal().string());
+    add(folders, (prefix / ".." / "src" / "variational_formation" / "config").lexically_normal().string());
+  }
   return folders;
 }
 

@@ -68,7 +68,7 @@ class DataTest(TempDirTestCase):
         path = self.write("t.csv", "step,t,agent,x,y,z\n0,0,0,1,2,3\n0,0,1,4,5,6\n1,0.1,0,7,8,9\n")
         status, lines = self.helper_fails(f"from variational_formation import data; data.read_trajectory({path!r}, 2)")
         self.assertEqual(status, 2)
-        self.assertIn("not a multiple of 2 agents", lines[-1])
+        self.assertIn("rows are not agents 0..1 step after step", lines[-1])
 
     def test_missing_scenario_field_fails(self):
         path = self.write("s.yaml", "name: x\ndimension: 2\n")

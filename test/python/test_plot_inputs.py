@@ -16,8 +16,8 @@ import sys
 import tempfile
 import unittest
 
-import genpy
 import rosbag
+import rospy
 from geometry_msgs.msg import Vector3
 from variational_formation.msg import AgentState, FormationStatus
 
@@ -53,7 +53,7 @@ def write_bag(parts, traj, metrics, dimension, ns):
         k = int(r["step"])
         msg = AgentState(id=int(r["agent"]), step=k, time=float(r["t"]),
                          position=[float(r[c]) for c in "xyz"[:dimension]])
-        bags[k // per_part].write(f"{ns}/agent_{r['agent']}/state", msg, genpy.Time.from_sec(1 + float(r["t"])))
+        bags[k // per_part].write(f"{ns}/agent_{r['agent']}/state", msg, rospy.Time.from_sec(1 + float(r["t"])))
     for m in status:
         k = int(m["step"])
         msg = FormationStatus(step=k, time=float(m["t"]), energy=float(m["energy"]),
@@ -61,7 +61,7 @@ def write_bag(parts, traj, metrics, dimension, ns):
                               linear_momentum=Vector3(float(m["px"]), float(m["py"]), float(m["pz"])),
                               angular_momentum=Vector3(float(m["ax"]), float(m["ay"]), float(m["az"])),
                               converged_step=-1)
-        bags[k // per_part].write(f"{ns}/status", msg, genpy.Time.from_sec(1 + float(m["t"])))
+        bags[k // per_part].write(f"{ns}/status", msg, rospy.Time.from_sec(1 + float(m["t"])))
     for bag in bags:
         bag.close()
 

@@ -88,8 +88,8 @@ class ScenarioNames(unittest.TestCase):
         plot = run("/usr/bin/python3", os.path.join(SOURCE, "scripts", "plot_roa.py"), "--roa", "roa.csv",
                    "--scenario", "hexagon", "--agent", "1", "--out", "roa.png")
         self.assertEqual(plot.returncode, 0, plot.stderr)
-        from catkin.find_in_workspaces import find_in_workspaces
-        simulate = find_in_workspaces(["libexec"], PKG, "simulate", first_match_only=True)[0]
+        import roslib.packages
+        simulate = roslib.packages.find_node(PKG, "simulate")[0]
         euler = run("/usr/bin/python3", os.path.join(SOURCE, "scripts", "euler_comparison.py"), "--scenario", "square",
                     "--duration", "0.1", "--out-dir", "euler", "--simulate", simulate)
         self.assertEqual(euler.returncode, 0, euler.stderr)

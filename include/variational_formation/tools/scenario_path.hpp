@@ -8,8 +8,10 @@ namespace vf {
 /**
  * The folders where a scenario name is looked up, in order: `<entry>/variational_formation/config`
  * (and `<entry>/config` for an entry that is the package itself) for each entry of
- * ROS_PACKAGE_PATH, as roslaunch's $(find) would; then the installed package's share folder and
- * the source folder this build was made from (compiled in), so that no ROS set-up is needed.
+ * ROS_PACKAGE_PATH, as roslaunch's $(find) would; then, found from the running program's own
+ * path, the share folder of the install space it lives in (<prefix>/share/variational_formation)
+ * or the sources of the catkin workspace whose devel space it lives in
+ * (<ws>/src/variational_formation), so that no ROS set-up is needed.
  */
 std::vector<std::string> scenarioFolders();
 
