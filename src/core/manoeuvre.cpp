@@ -9,7 +9,11 @@ ManoeuvreGains manoeuvreGains(const Command& command, const VariationalCoefficie
   ManoeuvreGains g;
   const double h = c.timeStep;
   const double oneMinusDecay = -std::expm1(-c.dampingGain * h);  // 1 - e^{-kappa h}, accurately
-  for (int a = 0; a < 3; ++a) g.translation[a] = oneMinusDecay * h * command.velocity(a);
+  const double startShift = h * std::tanh(0.5 * c.dampingGain * h);  // h - 2h/(1 + e^{kappa h})
+  for (int a = 0; a < 3; ++a) {
+    g.translation[a] = oneMinusDecay * h * command.velocity(a);
+    g.startTranslation[a] = startShift * command.velocity(a);
+  }
   g.scaleSquared = command.scale * command.scale;
   const double rate = command.angularRate.norm();
   if (rate > 0.0) {
@@ -35,6 +39,7 @@ ManoeuvreGains nodeGains(const ManoeuvreGains& before, const ManoeuvreGains& aft
   ManoeuvreGains g;
   for (int a = 0; a < 3; ++a) {
     g.translation[a] = 0.5 * (before.translation[a] + after.translation[a]);
+    g.startTranslation[a] = 0.5 * (before.startTranslation[a] + after.startTranslation[a]);
     for (int b = 0; b < 3; ++b) g.rotation[a][b] = 0.5 * (before.rotation[a][b] + after.rotation[a][b]);
   }
   g.scaleSquared = 0.5 * (before.scaleSquared + after.scaleSquared);

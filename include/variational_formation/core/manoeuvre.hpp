@@ -19,6 +19,8 @@ namespace vf {
  */
 struct ManoeuvreGains {
   double translation[3] = {0.0, 0.0, 0.0};
+  /// h tanh(kappa h / 2) v* [m]: the start's translation (see manoeuvreStart).
+  double startTranslation[3] = {0.0, 0.0, 0.0};
   double rotation[3][3] = {{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}};
   /// s^2: V_s uses the squared desired distances s^2 d_ij^2.
   double scaleSquared = 1.0;
@@ -31,14 +33,19 @@ ManoeuvreGains manoeuvreGains(const Command& command, const VariationalCoefficie
 /// The trapezoid's node forcing at t_{k+1} between intervals k and k+1: the mean of the two.
 ManoeuvreGains nodeGains(const ManoeuvreGains& before, const ManoeuvreGains& after);
 
-/// Coordinate a of f_i = translation + rotation r_i [m]; offset (r_i, d doubles) is read only if
-/// the gains rotate.
-inline double manoeuvreForcing(const ManoeuvreGains& g, int dimension, int a, const double* offset) {
-  double f = g.translation[a];
+/// Coordinate a of the rotation part of f_i, rotation r_i [m]; offset (r_i, d doubles) is read
+/// only if the gains rotate.
+inline double rotationForcing(const ManoeuvreGains& g, int dimension, int a, const double* offset) {
+  double f = 0.0;
   if (g.rotates) {
     for (int b = 0; b < dimension; ++b) f += g.rotation[a][b] * offset[b];
   }
   return f;
+}
+
+/// Coordinate a of f_i = translation + rotation r_i [m].
+inline double manoeuvreForcing(const ManoeuvreGains& g, int dimension, int a, const double* offset) {
+  return g.translation[a] + rotationForcing(g, dimension, a, offset);
 }
 
 /**
@@ -57,15 +64,18 @@ inline void manoeuvreUpdate(const VariationalCoefficients& c, const ManoeuvreGai
 }
 
 /**
- * The forced variational start (doc/maths.md §9): p-_0 = v_0 with the trapezoid's force at q_0,
- * q_1 = q_0 + 2h/(1 + e^{kappa h}) (v_0 - h/2 grad V_s(q_0)) + f_i(q_0)/2. Second order.
+ * The forced variational start (doc/maths.md §9): today's variational start in the frame moving
+ * at v*, with half the trapezoid's rotation force at q_0:
+ * q_1 = q_0 + h v* + 2h/(1 + e^{kappa h}) (v_0 - v* - h/2 grad V_s(q_0)) + (rotation r_i(q_0))/2,
+ * computed as q_0 + 2h/(1 + e^{kappa h})(v_0 - h/2 grad) + h tanh(kappa h/2) v* + rotation r_i/2.
+ * Second order; a pure translation then is today's run in the moving frame from the first step.
  */
 inline void manoeuvreStart(const VariationalCoefficients& c, const ManoeuvreGains& g, int dimension,
                            const double* q0, const double* v0, const double* gradient0,
                            const double* offset0, double* q1) {
   for (int a = 0; a < dimension; ++a) {
-    const double f = manoeuvreForcing(g, dimension, a, offset0);
-    q1[a] = q0[a] + c.startGain * (v0[a] - 0.5 * c.timeStep * gradient0[a]) + 0.5 * f;
+    const double f = g.startTranslation[a] + 0.5 * rotationForcing(g, dimension, a, offset0);
+    q1[a] = q0[a] + c.startGain * (v0[a] - 0.5 * c.timeStep * gradient0[a]) + f;
   }
 }
 
