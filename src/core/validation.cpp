@@ -150,7 +150,22 @@ void validateManoeuvre(Scenario& s, const Formation& formation, const FieldNames
     moves = moves || segment.command.rotates() || !segment.command.velocity.isZero(0.0);
     largestScale = std::max(largestScale, segment.command.scale);
   }
-  if (turns) checkFormationCanTurn(formation, "manoeuvre");
+  if (turns) {
+    checkFormationCanTurn(formation, "manoeuvre");
+    // doc/maths.md §9: turning softens the shape modes by about w*^2; half the softest mode's
+    // frequency (s w_min at scale s) is the range tested to hold the shape.
+    const double softest = minStiffnessFrequency(formation, formation.desiredShape());
+    for (std::size_t i = 0; i < s.manoeuvre.size(); ++i) {
+      const Command& c = s.manoeuvre[i].command;
+      const double allowed = 0.5 * c.scale * softest;
+      if (c.angularRate.norm() > allowed) {
+        s.warnings.push_back("manoeuvre[" + std::to_string(i) + "].angular_rate: |omega| = " +
+                             show(c.angularRate.norm()) + " rad/s is above half the softest shape mode's frequency (" +
+                             show(allowed) + " rad/s at scale " + show(c.scale) +
+                             "): the turning formation may be slow to take its shape, or lose it");
+      }
+    }
+  }
   if (moves && s.dampingGain == 0.0) {
     s.warnings.push_back("manoeuvre: " + names.dampingGain +
                          " = 0: the damping is the gain that drives the velocities to the command, so "

@@ -150,6 +150,19 @@ TEST(BadSchedule, AnAgentThatCannotKnowItsCentroidOffsetCannotTurn) {
   expectBadInput({"--scenario", sc, "--out", tempPath("x.csv")}, "manoeuvre: agent 0 cannot know its offset from the centroid");
 }
 
+TEST(SimulateManoeuvre, WarnsWhenTurningFasterThanHalfTheSoftestShapeMode) {
+  // The hexagon's softest mode: 1.92 rad/s at scale 1. 0.9 rad/s is below half of it, 1.2 above.
+  const std::string slow = write("slow.yaml", hexagonWith("manoeuvre:\n  - {angular_rate: 0.9}\n"));
+  const std::string fast = write("fastwarn.yaml", hexagonWith("manoeuvre:\n  - {angular_rate: 1.2}\n"));
+  const CliResult a = simulate({"--scenario", slow, "--out", tempPath("x.csv"), "--steps", "10"});
+  const CliResult b = simulate({"--scenario", fast, "--out", tempPath("x.csv"), "--steps", "10"});
+  EXPECT_EQ(a.status, 0);
+  EXPECT_EQ(a.err.find("softest"), std::string::npos) << a.err;
+  EXPECT_EQ(b.status, 0);
+  EXPECT_NE(b.err.find("simulate: warning: manoeuvre[0].angular_rate: |omega| = 1.2 rad/s is above half the softest"),
+            std::string::npos) << b.err;
+}
+
 // One test per kind of bad commands file.
 void expectBadCommands(const std::string& name, const std::string& csv, const std::string& fragment) {
   const std::string path = write(name + ".csv", csv);
