@@ -57,6 +57,12 @@ void ManoeuvreModel::add(long step, const Command& command) {
   gains_.push_back(manoeuvreGains(command, coefficients_));
 }
 
+void ManoeuvreModel::replaceFrom(long step, const Command& command) {
+  schedule_.replaceFrom(step, command);
+  gains_.resize(schedule_.entries().size() - 1);
+  gains_.push_back(manoeuvreGains(command, coefficients_));
+}
+
 const ManoeuvreGains& ManoeuvreModel::intervalGains(long step) const {
   const long i = schedule_.entryIndex(step);
   return i < 0 ? zero_ : gains_[static_cast<std::size_t>(i)];

@@ -21,6 +21,12 @@ void CommandSchedule::add(long step, const Command& command, const std::string& 
   entries_.emplace_back(step, command);
 }
 
+void CommandSchedule::replaceFrom(long step, const Command& command, const std::string& field) {
+  if (step < 0) throw InvalidInput(field + ": must be >= 0, got " + std::to_string(step));
+  entries_.erase(entries_.begin() + (entryIndex(step - 1) + 1), entries_.end());
+  entries_.emplace_back(step, command);
+}
+
 long CommandSchedule::entryIndex(long step) const {
   // The last entry whose step is <= step.
   const auto it = std::upper_bound(entries_.begin(), entries_.end(), step,

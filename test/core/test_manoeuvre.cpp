@@ -45,13 +45,7 @@ Positions perturbed(const Formation& f) {
   return q;
 }
 
-Command command(Vector3 v, Vector3 w, double s) {
-  Command c;
-  c.velocity = v;
-  c.angularRate = w;
-  c.scale = s;
-  return c;
-}
+using test::command;
 
 // ---------------------------------------------------------------------------------------------
 // Motion parameters

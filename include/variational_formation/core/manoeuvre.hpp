@@ -90,6 +90,8 @@ class ManoeuvreModel {
 
   /// Appends a step-stamped command (see CommandSchedule::add).
   void add(long step, const Command& command);
+  /// A step-stamped command that replaces the schedule from its step on (CommandSchedule::replaceFrom).
+  void replaceFrom(long step, const Command& command);
   const CommandSchedule& schedule() const { return schedule_; }
   /// Gains of interval k.
   const ManoeuvreGains& intervalGains(long step) const;

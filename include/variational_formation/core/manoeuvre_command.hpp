@@ -46,6 +46,9 @@ class CommandSchedule {
   /// Appends (step, command). @throws InvalidInput naming `field` unless step > the last step
   /// (>= 0 for the first).
   void add(long step, const Command& command, const std::string& field = "step");
+  /// From `step` on, `command` replaces the schedule: entries at step or later are dropped, then
+  /// (step, command) is appended. @throws InvalidInput naming `field` if step < 0.
+  void replaceFrom(long step, const Command& command, const std::string& field = "step");
   /// The command of interval k.
   const Command& at(long step) const;
   /// Index in entries() of the entry governing interval k, -1 before the first entry.
