@@ -107,6 +107,14 @@ TEST(MotionParameters, AnAgentWhoseEdgesMissTheCentroidOffsetDoesNotQualify) {
                InvalidInput);
 }
 
+TEST(MotionParameters, EveryShippedScenarioQualifiesToTurn) {
+  for (const char* name : {"hexagon", "square", "tetrahedron", "tetrahedron_paper", "grid24", "lattice48",
+                           "hexagon_manoeuvre"}) {
+    const Formation f = makeFormation(loadScenario(test::configPath(name)));
+    EXPECT_NO_THROW(checkFormationCanTurn(f, "manoeuvre")) << name;
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // The discrete relative equilibrium
 
