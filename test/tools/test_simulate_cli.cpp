@@ -16,26 +16,16 @@
 #include "variational_formation/core/validation.hpp"
 #include "variational_formation/tools/arguments.hpp"
 #include "variational_formation/tools/simulate_cli.hpp"
+#include "simulate_test_support.hpp"
 
 namespace vf {
 namespace {
 
 const std::string kConfig = std::string(VF_SOURCE_DIR) + "/config/";
 
-struct CliResult {
-  int status;
-  std::string out;
-  std::string err;
-};
-
-CliResult simulate(std::vector<std::string> args) {
-  args.insert(args.begin(), "simulate");
-  std::vector<const char*> argv;
-  for (const auto& a : args) argv.push_back(a.c_str());
-  std::ostringstream out, err;
-  const int status = runSimulateCli(static_cast<int>(argv.size()), argv.data(), out, err);
-  return {status, out.str(), err.str()};
-}
+using test::CliResult;
+using test::simulate;
+using test::expectBadInput;
 
 std::vector<std::string> lines(const std::string& path) {
   std::ifstream in(path);
@@ -46,14 +36,6 @@ std::vector<std::string> lines(const std::string& path) {
 
 std::string tempPath(const std::string& name) {
   return ::testing::TempDir() + "vf_cli_" + name;
-}
-
-void expectBadInput(const std::vector<std::string>& args, const std::string& fragment) {
-  const CliResult r = simulate(args);
-  EXPECT_EQ(r.status, 2) << r.err;
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-  EXPECT_EQ(r.err.rfind("simulate: error: ", 0), 0u) << r.err;
-  EXPECT_NE(r.err.find(fragment), std::string::npos) << r.err << " / " << fragment;
 }
 
 // The comma-separated fields of a CSV row, parsed as doubles (strtod reads "nan" and "inf").

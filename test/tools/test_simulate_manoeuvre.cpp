@@ -10,26 +10,16 @@
 #include <vector>
 
 #include "variational_formation/core/scenario.hpp"
-#include "variational_formation/tools/simulate_cli.hpp"
+#include "simulate_test_support.hpp"
 
 namespace vf {
 namespace {
 
 const std::string kConfig = std::string(VF_SOURCE_DIR) + "/config/";
 
-struct CliResult {
-  int status;
-  std::string err;
-};
-
-CliResult simulate(std::vector<std::string> args) {
-  args.insert(args.begin(), "simulate");
-  std::vector<const char*> argv;
-  for (const auto& a : args) argv.push_back(a.c_str());
-  std::ostringstream out, err;
-  const int status = runSimulateCli(static_cast<int>(argv.size()), argv.data(), out, err);
-  return {status, err.str()};
-}
+using test::CliResult;
+using test::simulate;
+using test::expectBadInput;
 
 std::string tempPath(const std::string& name) { return ::testing::TempDir() + "vf_manoeuvre_" + name; }
 
@@ -44,14 +34,6 @@ std::string slurp(const std::string& path) {
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
-}
-
-void expectBadInput(const std::vector<std::string>& args, const std::string& fragment) {
-  const CliResult r = simulate(args);
-  EXPECT_EQ(r.status, 2) << r.err;
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-  EXPECT_EQ(r.err.rfind("simulate: error: ", 0), 0u) << r.err;
-  EXPECT_NE(r.err.find(fragment), std::string::npos) << r.err << " / " << fragment;
 }
 
 // The hexagon scenario without its manoeuvre, with `manoeuvre` appended.
