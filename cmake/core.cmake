@@ -23,6 +23,11 @@ add_library(variational_formation_core
   src/core/timed_agent.cpp
   src/core/point_robot.cpp
   src/core/record_ledger.cpp
+  src/core/manoeuvre_command.cpp
+  src/core/motion_parameters.cpp
+  src/core/manoeuvre.cpp
+  src/core/manoeuvre_integrator.cpp
+  src/core/tracking.cpp
 )
 target_include_directories(variational_formation_core PUBLIC
   $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/include>)

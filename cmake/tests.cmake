@@ -1,7 +1,7 @@
 # gtest unit tests: one file per core concept, run by `catkin_make run_tests`.
 if(CATKIN_ENABLE_TESTING)
   set(VF_CORE_TESTS formation integrators metrics stability scenario free_particle lockstep simulation
-    timed_agent link_faults point_robot record_ledger layers)
+    timed_agent link_faults point_robot record_ledger layers manoeuvre lockstep_manoeuvre)
   foreach(name ${VF_CORE_TESTS})
     catkin_add_gtest(test_${name} test/core/test_${name}.cpp)
     target_link_libraries(test_${name} variational_formation_core gtest_main)
@@ -12,6 +12,10 @@ if(CATKIN_ENABLE_TESTING)
   target_link_libraries(test_simulate_cli variational_formation_tools gtest_main)
   target_compile_options(test_simulate_cli PRIVATE ${VF_FLAGS})
   target_compile_definitions(test_simulate_cli PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  catkin_add_gtest(test_simulate_manoeuvre test/tools/test_simulate_manoeuvre.cpp)
+  target_link_libraries(test_simulate_manoeuvre variational_formation_tools gtest_main)
+  target_compile_options(test_simulate_manoeuvre PRIVATE ${VF_FLAGS})
+  target_compile_definitions(test_simulate_manoeuvre PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 endif()
 
 # The documentation against the code (test/doc/test_docs.py): doc/ros_api.md lists exactly the

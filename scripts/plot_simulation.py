@@ -4,7 +4,9 @@ file or a name in the package's config/; files of another formation (agent count
 step count) are refused.
 
 usage: plot_simulation.py --scenario FILE|NAME --traj traj.csv --metrics metrics.csv
-                          [--out-dir output] [--prefix NAME]
+                          [--out-dir output] [--prefix NAME] [--commands FILE.csv]
+With a manoeuvre (the scenario's, or --commands as given to simulate) it also draws
+<prefix>_manoeuvre.png: the centroid's path against the commanded one, and the shape at a few instants.
 """
 import argparse
 import os
@@ -23,6 +25,7 @@ def main():
     parser.add_argument("--metrics", required=True)
     parser.add_argument("--out-dir", default="output")
     parser.add_argument("--prefix", default=None)
+    parser.add_argument("--commands", default=None)
     args = parser.parse_args()
     scenario = data.read_scenario(args.scenario)
     q = data.read_trajectory(args.traj, scenario.n, scenario.dimension, f"the scenario {scenario.name}")
@@ -33,6 +36,10 @@ def main():
     prefix = args.prefix or scenario.name or "run"
     paths = plots.plot_all(args.out_dir, prefix, prefix, m.t, q, scenario.dimension, m.energy, m.error,
                            m.p, m.a, scenario.kappa, h, scenario.edges)
+    commanded = data.commanded_velocities(args.scenario, len(m.t) - 1, h, args.commands)
+    if commanded is not None:
+        paths["manoeuvre"] = os.path.join(args.out_dir, f"{prefix}_manoeuvre.png")
+        plots.plot_manoeuvre(paths["manoeuvre"], prefix, m.t, q, scenario.edges, commanded)
     for p in paths.values():
         print(f"wrote {p}")
     print(plots.summary(m.t, m.energy, m.error, m.p, m.a, scenario.kappa, h))

@@ -103,6 +103,27 @@ void Formation::agentGradient(int agent, const Positions& q, double* out) const 
   }
 }
 
+void Formation::agentScaledGradient(int agent, const Positions& q, double scaleSquared,
+                                    double* out) const {
+  const double* qi = q.col(agent).data();
+  for (int c = 0; c < dimension_; ++c) out[c] = 0.0;
+  for (const Neighbour& nb : neighbours_[agent]) {
+    const double* qj = q.col(nb.agent).data();
+    const double gamma = squaredDistance(qi, qj, dimension_) - scaleSquared * nb.desiredDistanceSquared;
+    for (int c = 0; c < dimension_; ++c) out[c] += gamma * (qi[c] - qj[c]);
+  }
+}
+
+double Formation::scaledPotential(const Positions& q, double scaleSquared) const {
+  double v = 0.0;
+  for (const Edge& e : edges_) {
+    const double gamma = squaredDistance(q.col(e.tail).data(), q.col(e.head).data(), dimension_) -
+                         scaleSquared * e.desiredDistanceSquared;
+    v += 0.25 * gamma * gamma;
+  }
+  return v;
+}
+
 void Formation::gradient(const Positions& q, Gradients& out) const {
   out.resize(dimension_, agentCount());
   for (int i = 0; i < agentCount(); ++i) agentGradient(i, q, out.col(i).data());

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "variational_formation/core/error.hpp"
+#include "variational_formation/core/validation.hpp"
 
 namespace vf {
 
@@ -27,6 +28,33 @@ LockstepAgent::LockstepAgent(const Scenario& scenario, int id, StartMethod start
   for (const Neighbour& nb : formation_.neighbours(id)) neighbourIds_.push_back(nb.agent);
   neighbours_.resize(static_cast<std::size_t>(n));
   neighbourhoodPositions_ = Positions::Zero(dimension_, n);
+  motionParameters_ = motionParameters(formation_, id);
+  if (!scenario.manoeuvre.empty()) {
+    manoeuvre_ = std::make_unique<ManoeuvreModel>(coefficients_,
+                                                  scheduleFromSegments(scenario.manoeuvre, scenario.timeStep));
+  }
+}
+
+LockstepAgent::CommandReceipt LockstepAgent::receiveCommand(long step, const Command& command, std::string* error) {
+  if (step < step_) return CommandReceipt::Late;
+  try {
+    validateCommand(command, dimension_, coefficients_.timeStep, CommandFieldNames::keys("command"));
+  } catch (const InvalidInput& e) {
+    if (error) *error = e.what();
+    return CommandReceipt::Invalid;
+  }
+  if (command.rotates() && !motionParameters_.exact) {
+    if (error) *error = motionParameters_.problem;
+    return CommandReceipt::CannotTurn;
+  }
+  if (!manoeuvre_) manoeuvre_ = std::make_unique<ManoeuvreModel>(coefficients_, CommandSchedule{});
+  manoeuvre_->replaceFrom(step, command);
+  return CommandReceipt::Accepted;
+}
+
+const CommandSchedule& LockstepAgent::commands() const {
+  static const CommandSchedule none;
+  return manoeuvre_ ? manoeuvre_->schedule() : none;
 }
 
 std::string LockstepAgent::describe(Receipt receipt) {
@@ -101,21 +129,34 @@ void LockstepAgent::advance() {
     const double* qj = neighbourPositionAtStep(neighbours_[static_cast<std::size_t>(j)]);
     for (int a = 0; a < dimension_; ++a) neighbourhoodPositions_(a, j) = qj[a];
   }
-  double gradient[3];
-  formation_.agentGradient(id_, neighbourhoodPositions_, gradient);
   std::vector<double> next(static_cast<std::size_t>(dimension_));
-  if (step_ > 0) {
-    // doc/maths.md §2, explicit update, as in VariationalIntegrator::step.
-    variationalUpdate(coefficients_, dimension_, qPrev_.data(), q_.data(), gradient, next.data());
-  } else if (start_ == StartMethod::Variational) {
-    variationalStart(coefficients_, dimension_, q_.data(), v0_.data(), gradient, next.data());
+  if (manoeuvre_) {
+    manoeuvreStep(next.data());
   } else {
-    paperStart(coefficients_, dimension_, q_.data(), v0_.data(), next.data());
+    double gradient[3];
+    formation_.agentGradient(id_, neighbourhoodPositions_, gradient);
+    variationalStep(coefficients_, start_, step_, dimension_, qPrev_.data(), q_.data(), v0_.data(), gradient,
+                    next.data());
   }
   qBeforePrev_.swap(qPrev_);
   qPrev_.swap(q_);
   q_.swap(next);
   ++step_;
+}
+
+// doc/maths.md §9, as in ManoeuvreIntegrator::step.
+void LockstepAgent::manoeuvreStep(double* next) const {
+  const ManoeuvreGains g = manoeuvre_->updateGains(step_);
+  double gradient[3], offset[3] = {0.0, 0.0, 0.0};
+  formation_.agentScaledGradient(id_, neighbourhoodPositions_, g.scaleSquared, gradient);
+  if (g.rotates) centroidOffset(formation_, motionParameters_, id_, neighbourhoodPositions_, offset);
+  if (step_ > 0) {
+    manoeuvreUpdate(coefficients_, g, dimension_, qPrev_.data(), q_.data(), gradient, offset, next);
+  } else if (start_ == StartMethod::Variational) {
+    manoeuvreStart(coefficients_, g, dimension_, q_.data(), v0_.data(), gradient, offset, next);
+  } else {
+    paperStart(coefficients_, dimension_, q_.data(), v0_.data(), next);
+  }
 }
 
 void LockstepAgent::resume(long step, const std::vector<double>& position,

@@ -1,6 +1,8 @@
 #include "variational_formation/core/scenario.hpp"
 
+#include <charconv>
 #include <cmath>
+#include <type_traits>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -72,9 +74,50 @@ Eigen::VectorXd toVector(const YAML::Node& node, int dimension, const std::strin
   return v;
 }
 
+// doc/manoeuvres.md: a list of {until, velocity, angular_rate, scale}; the numbers are checked
+// by validateManoeuvre (validation.cpp).
+std::vector<ManoeuvreSegment> parseManoeuvre(const YAML::Node& list, int dimension) {
+  if (!list.IsSequence() || list.size() == 0) {
+    throw InvalidInput("manoeuvre: expected a non-empty list of segments, got " + describe(list));
+  }
+  std::vector<ManoeuvreSegment> segments;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string field = "manoeuvre[" + std::to_string(i) + "]";
+    const YAML::Node node = list[i];
+    if (!node.IsMap()) throw InvalidInput(field + ": expected a mapping, got " + describe(node));
+    rejectUnknownKeys(node, {"until", "velocity", "angular_rate", "scale"}, field);
+    const auto given = [&](const char* key) { return node[key].IsDefined() && !node[key].IsNull(); };
+    ManoeuvreSegment segment;
+    if (given("until")) {
+      segment.until = toFiniteDouble(node["until"], field + ".until");
+    } else if (i + 1 < list.size()) {
+      throw InvalidInput(field + ".until: missing (only the last segment may omit it)");
+    } else {
+      segment.until = std::numeric_limits<double>::infinity();
+    }
+    if (given("velocity")) {
+      segment.command.velocity.head(dimension) = toVector(node["velocity"], dimension, field + ".velocity");
+    }
+    if (given("angular_rate")) {
+      const std::string rate = field + ".angular_rate";
+      if (dimension == 2) {
+        if (!node["angular_rate"].IsScalar()) {
+          throw InvalidInput(rate + ": expected a number (the rate about z in 2D), got " + describe(node["angular_rate"]));
+        }
+        segment.command.angularRate.z() = toFiniteDouble(node["angular_rate"], rate);
+      } else {
+        segment.command.angularRate = toVector(node["angular_rate"], 3, rate);
+      }
+    }
+    if (given("scale")) segment.command.scale = toFiniteDouble(node["scale"], field + ".scale");
+    segments.push_back(segment);
+  }
+  return segments;
+}
+
 Scenario parseRoot(const YAML::Node& root) {
   if (!root.IsMap()) throw InvalidInput("scenario: expected a YAML mapping at the top level");
-  rejectUnknownKeys(root, {"name", "dimension", "kappa", "time_step", "steps", "agents", "edges"},
+  rejectUnknownKeys(root, {"name", "dimension", "kappa", "time_step", "steps", "agents", "edges", "manoeuvre"},
                     "");
   Scenario s;
   const YAML::Node name = required(root, "name", "name");
@@ -138,6 +181,8 @@ Scenario parseRoot(const YAML::Node& root) {
       s.edges.emplace_back(clamp(i), clamp(j));
     }
   }
+  const YAML::Node manoeuvre = root["manoeuvre"];
+  if (manoeuvre.IsDefined() && !manoeuvre.IsNull()) s.manoeuvre = parseManoeuvre(manoeuvre, s.dimension);
   return s;
 }
 
@@ -169,6 +214,86 @@ Scenario loadScenario(const std::string& path) {
   text << in.rdbuf();
   if (in.bad()) throw InvalidInput(path + ": cannot read the scenario file");
   return parseScenario(text.str(), path);
+}
+
+namespace {
+
+std::vector<std::string> splitFields(const std::string& line) {
+  std::vector<std::string> fields;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t comma = line.find(',', start);
+    fields.push_back(line.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (comma == std::string::npos) return fields;
+    start = comma + 1;
+  }
+}
+
+template <class T>
+T parseField(const std::string& text, const std::string& field) {
+  T value{};
+  const char* end = text.data() + text.size();
+  const auto result = std::from_chars(text.data(), end, value);
+  if (text.empty() || result.ec != std::errc() || result.ptr != end) {
+    throw InvalidInput(field + ": expected " + (std::is_integral<T>::value ? "an integer" : "a number") +
+                       ", got '" + text + "'");
+  }
+  return value;
+}
+
+}  // namespace
+
+CommandSchedule parseCommands(const std::string& text, const std::string& source, const Scenario& scenario) {
+  std::istringstream in(text);
+  std::string line;
+  long number = 0;
+  const auto next = [&]() {
+    if (!std::getline(in, line)) return false;
+    ++number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    return true;
+  };
+  try {
+    if (!next() || line != kCommandsHeader) {
+      throw InvalidInput("line 1: expected the header '" + std::string(kCommandsHeader) + "', got '" + line + "'");
+    }
+    static const char* const kColumns[] = {"step", "vx", "vy", "vz", "wx", "wy", "wz", "scale"};
+    CommandSchedule schedule;
+    while (next()) {
+      if (line.empty()) continue;
+      const std::string where = "line " + std::to_string(number);
+      const std::vector<std::string> fields = splitFields(line);
+      if (fields.size() != 8) {
+        throw InvalidInput(where + ": expected 8 columns (" + kCommandsHeader + "), got " + std::to_string(fields.size()));
+      }
+      const long step = parseField<long>(fields[0], where + ": step");
+      double x[7];
+      for (int c = 0; c < 7; ++c) x[c] = parseField<double>(fields[c + 1], where + ": " + kColumns[c + 1]);
+      Command command;
+      command.velocity = Vector3(x[0], x[1], x[2]);
+      command.angularRate = Vector3(x[3], x[4], x[5]);
+      command.scale = x[6];
+      validateCommand(command, scenario.dimension, scenario.timeStep, CommandFieldNames::columns(where));
+      if (step < 0) throw InvalidInput(where + ": step: must be >= 0, got " + std::to_string(step));
+      schedule.add(step, command, where + ": step");
+    }
+    if (schedule.empty()) throw InvalidInput("no command rows after the header");
+    if (schedule.rotates()) checkFormationCanTurn(makeFormation(scenario), "wx,wy,wz");
+    return schedule;
+  } catch (const InvalidInput& e) {
+    throw InvalidInput(source + ": " + e.what());
+  }
+}
+
+CommandSchedule loadCommands(const std::string& path, const Scenario& scenario) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InvalidInput(path + ": is a directory, not a commands file");
+  std::ifstream in(path);
+  if (!in) throw InvalidInput(path + ": cannot open the commands file");
+  std::stringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw InvalidInput(path + ": cannot read the commands file");
+  return parseCommands(text.str(), path, scenario);
 }
 
 Formation makeFormation(const Scenario& s) {

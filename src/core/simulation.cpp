@@ -4,7 +4,9 @@
 #include <ostream>
 
 #include "variational_formation/core/validation.hpp"
+#include "variational_formation/core/manoeuvre_integrator.hpp"
 #include "variational_formation/core/metrics.hpp"
+#include "variational_formation/core/tracking.hpp"
 
 namespace vf {
 
@@ -13,10 +15,15 @@ StepMetrics measure(const Integrator& integrator) {
   m.step = integrator.stepIndex();
   m.time = integrator.time();
   m.energy = integrator.energy();
-  m.maxDistanceError = integrator.formation().maxDistanceError(integrator.positions());
+  const double scale = integrator.commandedScale();
+  m.maxDistanceError = maxScaledDistanceError(integrator.formation(), integrator.positions(), scale);
   const Momenta p = integrator.momenta();
   m.linearMomentum = linearMomentum(p);
   m.angularMomentum = angularMomentum(integrator.positions(), p);
+  const Velocities v = integrator.velocities();
+  m.centroidVelocity = centroidVelocity(v);
+  m.rotationRate = rotationRate(integrator.positions(), v, integrator.timeStep());
+  m.scaleError = meanScaleError(integrator.formation(), integrator.positions(), scale);
   return m;
 }
 
@@ -31,6 +38,19 @@ void runScenario(const Scenario& scenario, Method method, StartMethod start,
   for (long k = 0; k < scenario.steps; ++k) {
     integrator->step();
     observe(*integrator);
+  }
+}
+
+void runManoeuvre(const Scenario& scenario, StartMethod start, const CommandSchedule& schedule,
+                  const std::function<void(const Integrator&)>& observe) {
+  validateSteps(scenario.steps, /*requireBounded=*/true);
+  const Formation formation = makeFormation(scenario);
+  ManoeuvreIntegrator integrator(formation, scenario.initialPositions, scenario.initialVelocities,
+                                 scenario.timeStep, scenario.dampingGain, start, schedule);
+  observe(integrator);
+  for (long k = 0; k < scenario.steps; ++k) {
+    integrator.step();
+    observe(integrator);
   }
 }
 
@@ -58,7 +78,7 @@ void writeTrajectoryRows(std::ostream& out, long step, double time, const Positi
 }
 
 void writeMetricsHeader(std::ostream& out) {
-  out << "step,t,energy,max_distance_error,px,py,pz,ax,ay,az\n";
+  out << "step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error\n";
 }
 
 void writeMetricsRow(std::ostream& out, const StepMetrics& m) {
@@ -71,10 +91,14 @@ void writeMetricsRow(std::ostream& out, const StepMetrics& m) {
     out << ',';
     put(out, m.linearMomentum(a));
   }
-  for (int a = 0; a < 3; ++a) {
-    out << ',';
-    put(out, m.angularMomentum(a));
+  for (const Vector3* x : {&m.angularMomentum, &m.centroidVelocity, &m.rotationRate}) {
+    for (int a = 0; a < 3; ++a) {
+      out << ',';
+      put(out, (*x)(a));
+    }
   }
+  out << ',';
+  put(out, m.scaleError);
   out << '\n';
 }
 

@@ -16,6 +16,17 @@ double maxStiffnessFrequency(const Formation& formation, const Positions& q) {
   return lambda > 0.0 ? std::sqrt(lambda) : 0.0;
 }
 
+double minStiffnessFrequency(const Formation& formation, const Positions& q) {
+  if (formation.edges().empty()) return 0.0;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(formation.hessian(q), Eigen::EigenvaluesOnly);
+  const Eigen::VectorXd& lambda = solver.eigenvalues();  // ascending
+  const double floor = 1e-9 * lambda.maxCoeff();
+  for (Eigen::Index i = 0; i < lambda.size(); ++i) {
+    if (lambda(i) > floor) return std::sqrt(lambda(i));
+  }
+  return 0.0;
+}
+
 bool isLinearlyStable(double timeStep, double frequency, double dampingGain) {
   if (!(frequency > 0.0)) return true;
   const double x = 0.5 * dampingGain * timeStep;

@@ -1,10 +1,12 @@
 #include "variational_formation/core/validation.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <utility>
 
 #include "variational_formation/core/error.hpp"
+#include "variational_formation/core/motion_parameters.hpp"
 #include "variational_formation/core/stability.hpp"
 #include "variational_formation/core/variational_update.hpp"
 
@@ -92,6 +94,92 @@ void validateScenario(Scenario& s, bool requireBoundedSteps, const FieldNames& n
   const StepSizeAdvice advice =
       adviseTimeStep(formation, s.initialPositions, s.timeStep, s.dampingGain, names.timeStep);
   if (advice.exceeded) s.warnings.push_back(advice.message);
+  validateManoeuvre(s, formation, names);
+}
+
+CommandFieldNames CommandFieldNames::keys(const std::string& prefix) {
+  return {prefix + ".velocity", prefix + ".angular_rate", prefix + ".scale"};
+}
+
+CommandFieldNames CommandFieldNames::columns(const std::string& prefix) {
+  return {prefix + ": vx,vy,vz", prefix + ": wx,wy,wz", prefix + ": scale"};
+}
+
+void validateCommand(const Command& c, int dimension, double timeStep, const CommandFieldNames& names) {
+  if (!c.velocity.allFinite()) throw InvalidInput(names.velocity + ": must be finite");
+  if (!c.angularRate.allFinite()) throw InvalidInput(names.angularRate + ": must be finite");
+  if (!(std::isfinite(c.scale) && c.scale > 0.0)) {
+    throw InvalidInput(names.scale + ": must be finite and > 0, got " + show(c.scale));
+  }
+  if (dimension == 2 && c.velocity.z() != 0.0) {
+    throw InvalidInput(names.velocity + ": a 2D formation has no z velocity, got " + show(c.velocity.z()));
+  }
+  if (dimension == 2 && (c.angularRate.x() != 0.0 || c.angularRate.y() != 0.0)) {
+    throw InvalidInput(names.angularRate + ": a 2D formation turns about z only, got x = " +
+                       show(c.angularRate.x()) + ", y = " + show(c.angularRate.y()));
+  }
+  const double turn = timeStep * c.angularRate.norm();
+  if (!(turn <= limits::kMaxTurnPerStep)) {
+    throw InvalidInput(names.angularRate + ": turns h |omega| = " + show(turn) + " rad per step, more than " +
+                       show(limits::kMaxTurnPerStep) + " (|omega| must be <= " +
+                       show(limits::kMaxTurnPerStep / timeStep) + " rad/s at h = " + show(timeStep) + ")");
+  }
+}
+
+void checkFormationCanTurn(const Formation& formation, const std::string& field) {
+  for (int i = 0; i < formation.agentCount(); ++i) {
+    const MotionParameters mu = motionParameters(formation, i);
+    if (!mu.exact) throw InvalidInput(field + ": " + mu.problem);
+  }
+}
+
+void validateManoeuvre(Scenario& s, const Formation& formation, const FieldNames& names) {
+  if (s.manoeuvre.empty()) return;
+  bool turns = false, moves = false;
+  double largestScale = 1.0;
+  for (std::size_t i = 0; i < s.manoeuvre.size(); ++i) {
+    const std::string field = "manoeuvre[" + std::to_string(i) + "]";
+    const ManoeuvreSegment& segment = s.manoeuvre[i];
+    if (!(segment.until > 0.0)) throw InvalidInput(field + ".until: must be > 0 s, got " + show(segment.until));
+    if (i > 0 && !(segment.until > s.manoeuvre[i - 1].until)) {
+      throw InvalidInput(field + ".until: must be greater than manoeuvre[" + std::to_string(i - 1) +
+                         "].until = " + show(s.manoeuvre[i - 1].until) + ", got " + show(segment.until));
+    }
+    validateCommand(segment.command, s.dimension, s.timeStep, CommandFieldNames::keys(field));
+    turns = turns || segment.command.rotates();
+    moves = moves || segment.command.rotates() || !segment.command.velocity.isZero(0.0);
+    largestScale = std::max(largestScale, segment.command.scale);
+  }
+  if (turns) {
+    checkFormationCanTurn(formation, "manoeuvre");
+    // doc/maths.md §9: turning softens the shape modes by about w*^2; half the softest mode's
+    // frequency (s w_min at scale s) is the range tested to hold the shape.
+    const double softest = minStiffnessFrequency(formation, formation.desiredShape());
+    for (std::size_t i = 0; i < s.manoeuvre.size(); ++i) {
+      const Command& c = s.manoeuvre[i].command;
+      const double allowed = 0.5 * c.scale * softest;
+      if (c.angularRate.norm() > allowed) {
+        s.warnings.push_back("manoeuvre[" + std::to_string(i) + "].angular_rate: |omega| = " +
+                             show(c.angularRate.norm()) + " rad/s is above half the softest shape mode's frequency (" +
+                             show(allowed) + " rad/s at scale " + show(c.scale) +
+                             "): the turning formation may be slow to take its shape, or lose it");
+      }
+    }
+  }
+  if (moves && s.dampingGain == 0.0) {
+    s.warnings.push_back("manoeuvre: " + names.dampingGain +
+                         " = 0: the damping is the gain that drives the velocities to the command, so "
+                         "the formation will not take up the commanded velocity or rate");
+  }
+  if (largestScale > 1.0) {
+    // The Hessian at the scaled shape is s^2 times the unscaled one: w grows as s.
+    const double w = largestScale * maxStiffnessFrequency(formation, formation.desiredShape());
+    if (!isLinearlyStable(s.timeStep, w, s.dampingGain)) {
+      s.warnings.push_back("manoeuvre: " + names.timeStep + " = " + show(s.timeStep) +
+                           " exceeds the linear stability limit " + show(stableTimeStepLimit(w, s.dampingGain)) +
+                           " s of the shape scaled by " + show(largestScale));
+    }
+  }
 }
 
 void applyOverrides(Scenario& s, const ScenarioOverrides& overrides, bool requireBoundedSteps) {

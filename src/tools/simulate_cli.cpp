@@ -19,8 +19,11 @@ const char* kUsage =
     "                [--method vi|euler|rk4] [--init variational|paper (vi only)]\n"
     "                [--time-step H] [--steps N] [--kappa K]\n"
     "                [--delay-steps D] [--loss P [--seed S]]   (vi only)\n"
+    "                [--commands FILE.csv]   (vi only; replaces the scenario's manoeuvre)\n"
     "Runs a formation scenario centrally. traj.csv: step,t,agent,x,y,z;\n"
-    "metrics.csv: step,t,energy,max_distance_error,px,py,pz,ax,ay,az.\n"
+    "metrics.csv: step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error.\n"
+    "--commands: rows step,vx,vy,vz,wx,wy,wz,scale, each applying from its step on\n"
+    "(doc/manoeuvres.md).\n"
     "Flags override the scenario file. --delay-steps D: each agent uses its neighbours'\n"
     "q_j^{k-D}; --loss P: each neighbour state is lost with probability P (seed S, default 1).\n"
     "Exit status 2 on bad input, 1 if the run diverges.\n";
@@ -63,7 +66,8 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
     const Arguments args(argc, argv,
                          {{"--scenario", 1}, {"--out", 1}, {"--metrics", 1}, {"--method", 1},
                           {"--init", 1}, {"--time-step", 1}, {"--steps", 1}, {"--kappa", 1},
-                          {"--delay-steps", 1}, {"--loss", 1}, {"--seed", 1}, {"--help", 0}, {"-h", 0}});
+                          {"--delay-steps", 1}, {"--loss", 1}, {"--seed", 1}, {"--commands", 1},
+                          {"--help", 0}, {"-h", 0}});
     if (args.has("--help") || args.has("-h")) {
       out << kUsage;
       return kExitOk;
@@ -80,6 +84,18 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
     const bool delayed = parseDelayFlags(args, method, delay);
     Scenario scenario = loadScenario(resolveScenario(args.text("--scenario")));
     applyOverrides(scenario, scenarioOverrides(args), /*requireBoundedSteps=*/true);
+    // A manoeuvre (the scenario's schedule, or --commands instead of it) runs the forced update.
+    const bool manoeuvre = args.has("--commands") || !scenario.manoeuvre.empty();
+    CommandSchedule schedule;
+    if (manoeuvre) {
+      const std::string what = args.has("--commands") ? "--commands" : "manoeuvre";
+      if (method != Method::Variational) {
+        throw InvalidInput(what + ": only with --method vi, got --method " + args.text("--method"));
+      }
+      if (delayed) throw InvalidInput(what + ": not with --delay-steps or --loss");
+      schedule = args.has("--commands") ? loadCommands(args.text("--commands"), scenario)
+                                        : scheduleFromSegments(scenario.manoeuvre, scenario.timeStep);
+    }
     for (const std::string& w : scenario.warnings) err << "simulate: warning: " << w << '\n';
 
     std::ofstream traj = openOutput("--out", args.text("--out"));
@@ -97,7 +113,9 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
         divergedAt = integrator.stepIndex();
       }
     };
-    if (delayed) {
+    if (manoeuvre) {
+      runManoeuvre(scenario, start, schedule, observe);
+    } else if (delayed) {
       runDelayedScenario(scenario, start, delay, observe);
     } else {
       runScenario(scenario, method, start, observe);

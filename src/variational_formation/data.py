@@ -12,7 +12,9 @@ import yaml
 from variational_formation.cli import fail
 
 TRAJECTORY_HEADER = "step,t,agent,x,y,z"
-METRICS_HEADER = "step,t,energy,max_distance_error,px,py,pz,ax,ay,az"
+METRICS_HEADER = ("step,t,energy,max_distance_error,px,py,pz,ax,ay,az,"
+                  "cvx,cvy,cvz,wx,wy,wz,scale_error")
+COMMANDS_HEADER = "step,vx,vy,vz,wx,wy,wz,scale"
 ROA_HEADER = "ix,iy,x,y,converged,converged_step,diverged"
 
 
@@ -55,9 +57,38 @@ def bag_parts(path):
 
 
 def read_metrics(path):
-    """simulate's metrics.csv: t, energy, max_distance_error, p[k, 3] and a[k, 3]."""
+    """simulate's metrics.csv: t, energy, max_distance_error, p[k, 3], a[k, 3], and the tracking
+    columns: centroid velocity cv[k, 3], rotation rate w[k, 3], mean scale error scale_error[k]."""
     m = load_csv(path, METRICS_HEADER)
-    return types.SimpleNamespace(t=m[:, 1], energy=m[:, 2], error=m[:, 3], p=m[:, 4:7], a=m[:, 7:10])
+    return types.SimpleNamespace(t=m[:, 1], energy=m[:, 2], error=m[:, 3], p=m[:, 4:7], a=m[:, 7:10],
+                                 cv=m[:, 10:13], w=m[:, 13:16], scale_error=m[:, 16])
+
+
+def commanded_velocities(scenario_path, steps, h, commands=None):
+    """v*[k, 3] of interval k (doc/manoeuvres.md): from a commands file if given, else from the
+    scenario's `manoeuvre:` (segment in force at t_k = k h); None if there is no command."""
+    v = np.zeros((steps, 3))
+    if commands:
+        rows = load_csv(commands, COMMANDS_HEADER)
+        for row in rows:
+            v[int(row[0]):] = row[1:4]
+        return v
+    try:
+        with open(scenario_path) as f:
+            segments = yaml.safe_load(f).get("manoeuvre")
+    except (OSError, yaml.YAMLError, AttributeError) as e:
+        fail(f"{scenario_path}: cannot read the manoeuvre ({e})")
+    if not segments:
+        return None
+    t = np.arange(steps) * h
+    chosen = np.full(steps, len(segments) - 1)
+    for s in reversed(range(len(segments))):
+        if "until" in segments[s]:
+            chosen[t < float(segments[s]["until"])] = s
+    for s, segment in enumerate(segments):
+        velocity = list(segment.get("velocity") or [])
+        v[chosen == s, :len(velocity)] = velocity
+    return v
 
 
 def scenario_folders():

@@ -51,6 +51,32 @@ def plot_trajectories(path, title, q, dimension, desired=None, edges=()):
     plt.close(fig)
 
 
+def plot_manoeuvre(path, title, t, q, edges, commanded_velocity, instants=5):
+    """The centroid's path against the commanded one (the initial centroid moved by the commanded
+    v*, interval by interval), and the shape at a few instants (2D, or the x-y view in 3D)."""
+    h = t[1] - t[0] if len(t) > 1 else 1.0
+    centroid = q.mean(axis=1)
+    commanded = centroid[0] + np.vstack([np.zeros(3), np.cumsum(commanded_velocity * h, axis=0)])
+    fig, ax = plt.subplots(figsize=(7.0, 5.6))
+    ax.plot(commanded[:, 0], commanded[:, 1], "--", color="0.3", lw=2.0, label="commanded centroid path")
+    ax.plot(centroid[:, 0], centroid[:, 1], color="tab:red", lw=1.0, label="centroid")
+    for n, k in enumerate(np.linspace(0, len(t) - 1, instants).astype(int)):
+        colour = plt.cm.viridis(n / max(instants - 1, 1))
+        for i, j in edges:
+            ax.plot([q[k, i, 0], q[k, j, 0]], [q[k, i, 1], q[k, j, 1]], color=colour, lw=1.0)
+        ax.plot(q[k, :, 0], q[k, :, 1], "o", ms=3, color=colour)
+        ax.annotate(f"t = {t[k]:.1f} s", centroid[k, :2], textcoords="offset points", xytext=(4, -12),
+                    fontsize="small", color=colour)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title(f"{title}: centroid path and shape")
+    ax.legend(fontsize="small", loc="best")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def _plot_semilogy(path, title, t, y, ylabel, what):
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
     positive = y > 0

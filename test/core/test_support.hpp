@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "variational_formation/core/manoeuvre_command.hpp"
 #include "variational_formation/core/scenario.hpp"
 
 namespace vf {
@@ -25,6 +26,15 @@ inline Formation tetrahedron() {
   Positions shape(3, 4);
   shape << a, a, -a, -a, a, -a, a, -a, a, -a, -a, a;
   return Formation(3, shape, {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}});
+}
+
+/// A command v* [m/s], omega* [rad/s], s.
+inline Command command(const Vector3& velocity, const Vector3& angularRate, double scale) {
+  Command c;
+  c.velocity = velocity;
+  c.angularRate = angularRate;
+  c.scale = scale;
+  return c;
 }
 
 }  // namespace test

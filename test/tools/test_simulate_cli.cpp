@@ -16,26 +16,16 @@
 #include "variational_formation/core/validation.hpp"
 #include "variational_formation/tools/arguments.hpp"
 #include "variational_formation/tools/simulate_cli.hpp"
+#include "simulate_test_support.hpp"
 
 namespace vf {
 namespace {
 
 const std::string kConfig = std::string(VF_SOURCE_DIR) + "/config/";
 
-struct CliResult {
-  int status;
-  std::string out;
-  std::string err;
-};
-
-CliResult simulate(std::vector<std::string> args) {
-  args.insert(args.begin(), "simulate");
-  std::vector<const char*> argv;
-  for (const auto& a : args) argv.push_back(a.c_str());
-  std::ostringstream out, err;
-  const int status = runSimulateCli(static_cast<int>(argv.size()), argv.data(), out, err);
-  return {status, out.str(), err.str()};
-}
+using test::CliResult;
+using test::simulate;
+using test::expectBadInput;
 
 std::vector<std::string> lines(const std::string& path) {
   std::ifstream in(path);
@@ -46,14 +36,6 @@ std::vector<std::string> lines(const std::string& path) {
 
 std::string tempPath(const std::string& name) {
   return ::testing::TempDir() + "vf_cli_" + name;
-}
-
-void expectBadInput(const std::vector<std::string>& args, const std::string& fragment) {
-  const CliResult r = simulate(args);
-  EXPECT_EQ(r.status, 2) << r.err;
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-  EXPECT_EQ(r.err.rfind("simulate: error: ", 0), 0u) << r.err;
-  EXPECT_NE(r.err.find(fragment), std::string::npos) << r.err << " / " << fragment;
 }
 
 // The comma-separated fields of a CSV row, parsed as doubles (strtod reads "nan" and "inf").
@@ -80,7 +62,7 @@ TEST(SimulateCli, WritesTrajectoryAndMetricsThatRoundTripTheLibrarysRun) {
   ASSERT_EQ(t.size(), 1u + 21u * 4u);
   ASSERT_EQ(m.size(), 22u);
   EXPECT_EQ(t[0], "step,t,agent,x,y,z");
-  EXPECT_EQ(m[0], "step,t,energy,max_distance_error,px,py,pz,ax,ay,az");
+  EXPECT_EQ(m[0], "step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error");
 
   // The same run through the library: every written number must read back as the very double
   // the library computed (17 significant digits round-trip), z = 0 in 2D.
@@ -90,13 +72,16 @@ TEST(SimulateCli, WritesTrajectoryAndMetricsThatRoundTripTheLibrarysRun) {
   runScenario(scenario, Method::Variational, StartMethod::Variational, [&](const Integrator& integ) {
     const StepMetrics expected = measure(integ);
     const std::vector<double> mv = numbers(m[static_cast<std::size_t>(integ.stepIndex()) + 1]);
-    ASSERT_EQ(mv.size(), 10u);
+    ASSERT_EQ(mv.size(), 17u);
     const double metricValues[] = {static_cast<double>(expected.step), expected.time, expected.energy,
                                    expected.maxDistanceError,         expected.linearMomentum(0),
                                    expected.linearMomentum(1),        expected.linearMomentum(2),
                                    expected.angularMomentum(0),       expected.angularMomentum(1),
-                                   expected.angularMomentum(2)};
-    for (int c = 0; c < 10; ++c) EXPECT_EQ(mv[c], metricValues[c]) << "metrics step " << expected.step << " column " << c;
+                                   expected.angularMomentum(2),       expected.centroidVelocity(0),
+                                   expected.centroidVelocity(1),      expected.centroidVelocity(2),
+                                   expected.rotationRate(0),          expected.rotationRate(1),
+                                   expected.rotationRate(2),          expected.scaleError};
+    for (int c = 0; c < 17; ++c) EXPECT_EQ(mv[c], metricValues[c]) << "metrics step " << expected.step << " column " << c;
     for (int i = 0; i < 4; ++i, ++row) {
       const std::vector<double> tv = numbers(t[row]);
       ASSERT_EQ(tv.size(), 6u);

@@ -56,6 +56,13 @@ class Formation {
    * @param out d doubles.
    */
   void agentGradient(int agent, const Positions& q, double* out) const;
+  /**
+   * grad_i V_s for the scaled distances s d_ij (doc/maths.md §9): gamma_ij = |q_i - q_j|^2 - s^2 d_ij^2.
+   * @param scaleSquared s^2 [1]. Same reads and order as agentGradient.
+   */
+  void agentScaledGradient(int agent, const Positions& q, double scaleSquared, double* out) const;
+  /// V_s(q) for the scaled distances s d_ij, @param scaleSquared s^2.
+  double scaledPotential(const Positions& q, double scaleSquared) const;
   /// Stacked gradient, d x n, agent by agent through agentGradient.
   void gradient(const Positions& q, Gradients& out) const;
   /// Hessian of V, (dn) x (dn), with agent i in rows/columns [d i, d i + d).

@@ -35,6 +35,8 @@ class Integrator {
   /// Energy at step k: the discrete energy E_d(q_{k-1}, q_k) for the variational scheme,
   /// 1/2|v|^2 + V(q) otherwise (and at k = 0).
   virtual double energy() const = 0;
+  /// The scale s the desired distances are multiplied by at step k (1 without a manoeuvre).
+  virtual double commandedScale() const { return 1.0; }
 
   long stepIndex() const { return step_; }
   double time() const { return static_cast<double>(step_) * timeStep_; }

@@ -1,8 +1,10 @@
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "variational_formation/core/manoeuvre.hpp"
 #include "variational_formation/core/scenario.hpp"
 #include "variational_formation/core/variational_update.hpp"
 
@@ -31,6 +33,22 @@ class LockstepAgent {
   /// state, and keeps nothing unless the state is Accepted.
   Receipt receive(long sender, long step, const std::vector<double>& position,
                   const std::vector<double>& previousPosition);
+  /// What became of a step-stamped command.
+  enum class CommandReceipt { Accepted, Late, Invalid, CannotTurn };
+
+  /**
+   * A broadcast command for the intervals from `step` on (doc/maths.md §9): it replaces the
+   * schedule (the scenario's `manoeuvre:` or earlier commands) from that step on. The update at
+   * step k (q_k -> q_{k+1}) uses the commands of intervals k - 1 and k, so a command is Late
+   * unless step >= step(); Invalid if validateCommand refuses it (`error` says why); CannotTurn
+   * if it turns and this agent's motion parameters are not exact. Refused commands change nothing.
+   * With the same commands at the same steps, the agents compute what ManoeuvreIntegrator
+   * computes, bit for bit.
+   */
+  CommandReceipt receiveCommand(long step, const Command& command, std::string* error = nullptr);
+  /// The commands this agent holds (empty without a manoeuvre).
+  const CommandSchedule& commands() const;
+
   /// Every neighbour's q_k is known.
   bool ready() const;
   /// Neighbour j's q_k is known.
@@ -69,6 +87,8 @@ class LockstepAgent {
     std::vector<double> position;
     std::vector<double> previousPosition;
   };
+  /// The forced update or start (doc/maths.md §9) from neighbourhoodPositions_; d doubles.
+  void manoeuvreStep(double* next) const;
   /// Neighbour's q_k if held, else nullptr.
   const double* neighbourPositionAtStep(const NeighbourState& s) const;
 
@@ -83,6 +103,10 @@ class LockstepAgent {
   std::vector<int> neighbourIds_;
   std::vector<NeighbourState> neighbours_;  // indexed by agent id (only neighbours used)
   Positions neighbourhoodPositions_;  // q_k of self and neighbours (other columns unused), d x n
+  // Set once the agent has a command (the scenario's manoeuvre, or a received one); until then
+  // advance() runs today's update unchanged.
+  std::unique_ptr<ManoeuvreModel> manoeuvre_;
+  MotionParameters motionParameters_;
 };
 
 }  // namespace vf

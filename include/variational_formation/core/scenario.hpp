@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "variational_formation/core/formation.hpp"
+#include "variational_formation/core/manoeuvre_command.hpp"
 
 namespace vf {
 
@@ -22,6 +23,9 @@ struct Scenario {
   Velocities initialVelocities;
   Positions desiredPositions;
   std::vector<std::pair<int, int>> edges;
+  /// The optional `manoeuvre:` schedule (doc/manoeuvres.md); empty = no command, today's run.
+  /// The last segment's until is +inf when omitted.
+  std::vector<ManoeuvreSegment> manoeuvre;
   /// Non-fatal findings, one line each (a non-rigid desired graph, a too large h).
   std::vector<std::string> warnings;
 
@@ -33,6 +37,15 @@ struct Scenario {
 Scenario loadScenario(const std::string& path);
 /// Parses and validates YAML text; `source` prefixes error messages.
 Scenario parseScenario(const std::string& yamlText, const std::string& source);
+/**
+ * Reads a commands file "step,vx,vy,vz,wx,wy,wz,scale" (doc/manoeuvres.md) for a validated
+ * scenario; every row goes through validateCommand, like the scenario's `manoeuvre:` segments.
+ * @throws InvalidInput "<file>: line N: <column>: <problem>".
+ */
+CommandSchedule loadCommands(const std::string& path, const Scenario& scenario);
+/// Parses the text of a commands file; `source` prefixes error messages.
+CommandSchedule parseCommands(const std::string& csvText, const std::string& source, const Scenario& scenario);
+
 /// The formation (desired shape and edges) of a validated scenario.
 Formation makeFormation(const Scenario& scenario);
 

@@ -4,6 +4,7 @@
 #include <iosfwd>
 
 #include "variational_formation/core/integrator.hpp"
+#include "variational_formation/core/manoeuvre_command.hpp"
 #include "variational_formation/core/scenario.hpp"
 
 namespace vf {
@@ -16,9 +17,14 @@ struct StepMetrics {
   double maxDistanceError = 0.0;
   Vector3 linearMomentum = Vector3::Zero();
   Vector3 angularMomentum = Vector3::Zero();
+  /// Tracking (tracking.hpp): centroid velocity [m/s], rotation rate [rad/s], mean scale error [1].
+  Vector3 centroidVelocity = Vector3::Zero();
+  Vector3 rotationRate = Vector3::Zero();
+  double scaleError = 0.0;
 };
 
-/// Energy, largest edge distance error and momenta at the integrator's current step.
+/// Energy, largest edge distance error (against s d_ij, s the commanded scale), momenta and
+/// tracking at the integrator's current step.
 StepMetrics measure(const Integrator& integrator);
 
 /**
@@ -28,10 +34,18 @@ StepMetrics measure(const Integrator& integrator);
 void runScenario(const Scenario& scenario, Method method, StartMethod start,
                  const std::function<void(const Integrator&)>& observe);
 
+/**
+ * Runs a validated scenario under a command schedule (its `manoeuvre:` converted by
+ * scheduleFromSegments, or a commands file) with the forced variational update
+ * (ManoeuvreIntegrator), calling observe at steps 0..steps.
+ */
+void runManoeuvre(const Scenario& scenario, StartMethod start, const CommandSchedule& schedule,
+                  const std::function<void(const Integrator&)>& observe);
+
 /// Writes "step,t,agent,x,y,z" (z = 0 in 2D), 17 significant digits.
 void writeTrajectoryHeader(std::ostream& out);
 void writeTrajectoryRows(std::ostream& out, long step, double time, const Positions& q);
-/// Writes "step,t,energy,max_distance_error,px,py,pz,ax,ay,az".
+/// Writes "step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error".
 void writeMetricsHeader(std::ostream& out);
 void writeMetricsRow(std::ostream& out, const StepMetrics& m);
 

@@ -10,6 +10,10 @@ namespace vf {
 /// Largest frequency w = sqrt(lambda_max(Hessian of V at q)) [1/s]; 0 if no eigenvalue is > 0.
 double maxStiffnessFrequency(const Formation& formation, const Positions& q);
 
+/// Smallest non-zero frequency sqrt(lambda) of the Hessian of V at q [1/s] (eigenvalues above
+/// 1e-9 of the largest): the softest shape mode; 0 if there is none.
+double minStiffnessFrequency(const Formation& formation, const Positions& q);
+
 /**
  * Linear stability limit of the variational update for a mode of frequency w (doc/maths.md §7):
  * stable iff h w < 2 cosh(kappa h / 2). Returns the smallest h > 0 with h w = 2 cosh(kappa h/2),

@@ -28,6 +28,9 @@ constexpr double kMaxTimeStep = 9.480751908109176e153;
 constexpr long kMaxSteps = 9007199254740992L;
 /// Longest pacing sleep h / real_time_factor [s]: a ROS duration holds int32 seconds.
 constexpr double kMaxPacingSeconds = 2147483647.0;
+/// Largest turn per step h |omega*| [rad] of a command (doc/maths.md §9: the rates tested stable
+/// are far below it; beyond it the rotation per step is too coarse to be tracked).
+constexpr double kMaxTurnPerStep = 0.1;
 }  // namespace limits
 
 /// The names under which values are reported: the scenario's fields, or the flags that set them.
@@ -56,6 +59,30 @@ void validateSteps(long steps, bool requireBounded, const std::string& field = "
 void validateRealTimeFactor(double realTimeFactor, double timeStep,
                             const std::string& field = "real_time_factor");
 
+/// The names under which a command's values are reported.
+struct CommandFieldNames {
+  std::string velocity, angularRate, scale;
+  /// A `manoeuvre:` segment's keys: "<prefix>.velocity", ".angular_rate", ".scale".
+  static CommandFieldNames keys(const std::string& prefix);
+  /// A commands file's columns: "<prefix>: vx,vy,vz", ": wx,wy,wz", ": scale".
+  static CommandFieldNames columns(const std::string& prefix);
+};
+
+/**
+ * The one check of a command (doc/manoeuvres.md), whether from a scenario's `manoeuvre:`, a
+ * commands file or a message: every number finite, scale > 0, in 2D no z velocity and no x, y
+ * angular rate, and h |omega*| <= limits::kMaxTurnPerStep.
+ * @param timeStep h [s] of the (validated) run. @throws InvalidInput naming the field.
+ */
+void validateCommand(const Command& command, int dimension, double timeStep, const CommandFieldNames& names);
+
+/**
+ * Turning needs every agent's motion parameters to be exact (motion_parameters.hpp).
+ * @throws InvalidInput "<field>: agent i cannot know its offset from the centroid: ..." for
+ * the first agent that does not qualify.
+ */
+void checkFormationCanTurn(const Formation& formation, const std::string& field);
+
 /**
  * Checks the numeric fields (validateDynamics, validateSteps) and the formation, and recomputes
  * the warnings (a non-rigid desired graph, h above the linear stability limit).
@@ -63,6 +90,13 @@ void validateRealTimeFactor(double realTimeFactor, double timeStep,
  */
 void validateScenario(Scenario& scenario, bool requireBoundedSteps = false,
                       const FieldNames& names = {});
+
+/**
+ * Checks a scenario's `manoeuvre:` (part of validateScenario): until values > 0 and increasing,
+ * each segment through validateCommand, and checkFormationCanTurn if any segment turns.
+ * Appends warnings (kappa = 0 cannot track a velocity or rate; h against the stiffer scaled shape).
+ */
+void validateManoeuvre(Scenario& scenario, const Formation& formation, const FieldNames& names = {});
 
 /// Replacements for scenario fields (command-line flags); unset ones keep the file's value.
 struct ScenarioOverrides {

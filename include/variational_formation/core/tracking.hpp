@@ -1,0 +1,30 @@
+#pragma once
+
+#include "variational_formation/core/formation.hpp"
+
+namespace vf {
+
+/**
+ * How well a formation follows a command (doc/manoeuvres.md, metrics.csv): measured from
+ * positions and velocities only, with no knowledge of the command but the scale.
+ */
+
+/// The centroid's velocity, the mean of the agents' velocities [m/s, world frame] (z = 0 in 2D).
+Vector3 centroidVelocity(const Velocities& v);
+
+/**
+ * The formation's rotation rate [rad/s, world frame; in 2D only z]: the rotation that best maps
+ * the centred configuration q - h v onto the centred q (least squares; Kabsch in 3D), as an
+ * angle per h about its axis. For the variational scheme, whose v is (q_k - q_{k-1})/h, that is
+ * the rotation of the last step: exact for a rigid discrete rotation. 0 with fewer than 2 agents.
+ */
+Vector3 rotationRate(const Positions& q, const Velocities& v, double timeStep);
+
+/// Mean over edges of |q_i - q_j| / d_ij, minus s [1]: 0 when every edge has length s d_ij,
+/// negative while the formation is smaller than commanded. 0 without edges.
+double meanScaleError(const Formation& formation, const Positions& q, double scale);
+
+/// max over edges of | |q_i - q_j| - s d_ij | [m] (Formation::maxDistanceError when s = 1).
+double maxScaledDistanceError(const Formation& formation, const Positions& q, double scale);
+
+}  // namespace vf

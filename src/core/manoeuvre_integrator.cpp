@@ -1,0 +1,91 @@
+#include "variational_formation/core/manoeuvre_integrator.hpp"
+
+#include "variational_formation/core/error.hpp"
+#include "variational_formation/core/validation.hpp"
+
+namespace vf {
+
+ManoeuvreIntegrator::ManoeuvreIntegrator(const Formation& formation, const Positions& q0,
+                                         const Velocities& v0, double timeStep, double dampingGain,
+                                         StartMethod start, CommandSchedule schedule)
+    : Integrator(formation, timeStep, dampingGain),
+      coefficients_(timeStep, dampingGain),
+      start_(start),
+      model_(coefficients_, std::move(schedule)),
+      v0_(v0),
+      qPrev_(q0),
+      q_(q0),
+      qNext_(q0) {
+  validateDynamics(timeStep, dampingGain);
+  for (int i = 0; i < formation.agentCount(); ++i) {
+    parameters_.push_back(vf::motionParameters(formation, i));
+    if (model_.schedule().rotates() && !parameters_.back().exact) {
+      throw InvalidInput("angular_rate: " + parameters_.back().problem);
+    }
+  }
+}
+
+void ManoeuvreIntegrator::forcing(const ManoeuvreGains& g, int agent, const Positions& q, double* out) const {
+  const int d = formation_.dimension();
+  double r[3] = {0.0, 0.0, 0.0};
+  if (g.rotates) centroidOffset(formation_, parameters_[static_cast<std::size_t>(agent)], agent, q, r);
+  for (int a = 0; a < d; ++a) out[a] = manoeuvreForcing(g, d, a, r);
+}
+
+void ManoeuvreIntegrator::step() {
+  const int d = formation_.dimension();
+  const int n = formation_.agentCount();
+  const ManoeuvreGains g = model_.updateGains(step_);
+  double gradient[3], offset[3] = {0.0, 0.0, 0.0};
+  for (int i = 0; i < n; ++i) {
+    formation_.agentScaledGradient(i, q_, g.scaleSquared, gradient);
+    if (g.rotates) centroidOffset(formation_, parameters_[static_cast<std::size_t>(i)], i, q_, offset);
+    double* next = qNext_.col(i).data();
+    if (step_ > 0) {
+      // doc/maths.md §9, the forced update.
+      manoeuvreUpdate(coefficients_, g, d, qPrev_.col(i).data(), q_.col(i).data(), gradient, offset, next);
+    } else if (start_ == StartMethod::Variational) {
+      manoeuvreStart(coefficients_, g, d, q_.col(i).data(), v0_.col(i).data(), gradient, offset, next);
+    } else {
+      paperStart(coefficients_, d, q_.col(i).data(), v0_.col(i).data(), next);
+    }
+  }
+  qPrev_.swap(q_);
+  q_.swap(qNext_);
+  ++step_;
+}
+
+Velocities ManoeuvreIntegrator::velocities() const {
+  if (step_ == 0) return v0_;
+  return (q_ - qPrev_) / timeStep_;
+}
+
+Momenta ManoeuvreIntegrator::momenta() const {
+  if (step_ == 0) return v0_;
+  const ManoeuvreGains& g = model_.intervalGains(step_ - 1);
+  const int d = formation_.dimension();
+  Momenta p(d, formation_.agentCount());
+  double gradient[3], f[3];
+  for (int i = 0; i < formation_.agentCount(); ++i) {
+    formation_.agentScaledGradient(i, q_, g.scaleSquared, gradient);
+    forcing(g, i, q_, f);
+    for (int a = 0; a < d; ++a) {
+      const double v = (q_(a, i) - qPrev_(a, i)) / timeStep_;
+      // (h/2) F_h = (h/2) f / b = f / (2 startGain)
+      p(a, i) = 0.5 * coefficients_.positionGain * v - 0.5 * timeStep_ * gradient[a] +
+                f[a] / (2.0 * coefficients_.startGain);
+    }
+  }
+  return p;
+}
+
+double ManoeuvreIntegrator::energy() const {
+  if (step_ == 0) {
+    return 0.5 * v0_.squaredNorm() + formation_.scaledPotential(q_, model_.intervalGains(0).scaleSquared);
+  }
+  const double s2 = model_.intervalGains(step_ - 1).scaleSquared;
+  const double kinetic = 0.5 * ((q_ - qPrev_) / timeStep_).squaredNorm();
+  return kinetic + 0.5 * (formation_.scaledPotential(qPrev_, s2) + formation_.scaledPotential(q_, s2));
+}
+
+}  // namespace vf

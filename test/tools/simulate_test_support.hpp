@@ -1,0 +1,41 @@
+#pragma once
+// The simulate CLI run in-process, shared by the simulate tests.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "variational_formation/tools/simulate_cli.hpp"
+
+namespace vf {
+namespace test {
+
+struct CliResult {
+  int status;
+  std::string out;
+  std::string err;
+};
+
+inline CliResult simulate(std::vector<std::string> args) {
+  args.insert(args.begin(), "simulate");
+  std::vector<const char*> argv;
+  for (const auto& a : args) argv.push_back(a.c_str());
+  std::ostringstream out, err;
+  const int status = runSimulateCli(static_cast<int>(argv.size()), argv.data(), out, err);
+  return {status, out.str(), err.str()};
+}
+
+/// Exit status 2 and exactly one line "simulate: error: ..." containing `fragment`.
+inline void expectBadInput(const std::vector<std::string>& args, const std::string& fragment) {
+  const CliResult r = simulate(args);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("simulate: error: ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find(fragment), std::string::npos) << r.err << " / " << fragment;
+}
+
+}  // namespace test
+}  // namespace vf
