@@ -22,6 +22,9 @@ struct Scenario {
   Velocities initialVelocities;
   Positions desiredPositions;
   std::vector<std::pair<int, int>> edges;
+  /// Initial heading [rad] of each agent's unicycle robot (field `initial_heading`, 2D only):
+  /// empty if no agent gives one, else one per agent (0 where not given).
+  std::vector<double> initialHeadings;
   /// Non-fatal findings, one line each (a non-rigid desired graph, a too large h).
   std::vector<std::string> warnings;
 
