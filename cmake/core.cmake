@@ -22,6 +22,8 @@ add_library(variational_formation_core
   src/core/agent_neighbourhood.cpp
   src/core/timed_agent.cpp
   src/core/point_robot.cpp
+  src/core/hand_point.cpp
+  src/core/unicycle_robot.cpp
   src/core/record_ledger.cpp
   src/core/manoeuvre_command.cpp
   src/core/motion_parameters.cpp

@@ -4,7 +4,8 @@ target_sources(variational_formation_core PRIVATE
   src/core/parallel.cpp
   src/core/delayed_integrator.cpp
   src/core/delay_margin.cpp
-  src/core/delay_campaign.cpp)
+  src/core/delay_campaign.cpp
+  src/core/robot_mode.cpp)
 target_sources(variational_formation_tools PRIVATE
   src/tools/progress.cpp
   src/tools/delay_margin_cli.cpp)
@@ -17,9 +18,11 @@ install(TARGETS delay_margin RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATIO
 if(CATKIN_ENABLE_TESTING)
   catkin_add_gtest(test_delayed_integrator test/core/test_delayed_integrator.cpp)
   target_link_libraries(test_delayed_integrator variational_formation_core gtest_main)
+  catkin_add_gtest(test_robot_mode test/core/test_robot_mode.cpp)
+  target_link_libraries(test_robot_mode variational_formation_core gtest_main)
   catkin_add_gtest(test_delay_margin test/tools/test_delay_margin.cpp)
   target_link_libraries(test_delay_margin variational_formation_tools gtest_main)
-  foreach(t test_delayed_integrator test_delay_margin)
+  foreach(t test_delayed_integrator test_robot_mode test_delay_margin)
     target_compile_options(${t} PRIVATE ${VF_FLAGS})
     target_compile_definitions(${t} PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   endforeach()

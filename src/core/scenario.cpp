@@ -146,7 +146,8 @@ Scenario parseRoot(const YAML::Node& root) {
     const std::string field = "agents[" + std::to_string(i) + "]";
     const YAML::Node agent = agents[i];
     if (!agent.IsMap()) throw InvalidInput(field + ": expected a mapping, got " + describe(agent));
-    rejectUnknownKeys(agent, {"id", "initial_position", "initial_velocity", "desired_position"},
+    rejectUnknownKeys(agent, {"id", "initial_position", "initial_velocity", "desired_position",
+                              "initial_heading"},
                       field);
     const long id = toInteger(required(agent, "id", field + ".id"), field + ".id");
     if (id != i) {
@@ -161,6 +162,11 @@ Scenario parseRoot(const YAML::Node& root) {
     }
     s.desiredPositions.col(i) = toVector(required(agent, "desired_position", field + ".desired_position"),
                                          s.dimension, field + ".desired_position");
+    if (agent["initial_heading"].IsDefined() && !agent["initial_heading"].IsNull()) {
+      s.initialHeadings.resize(static_cast<std::size_t>(n), 0.0);
+      s.initialHeadings[static_cast<std::size_t>(i)] =
+          toFiniteDouble(agent["initial_heading"], field + ".initial_heading");
+    }
   }
 
   const YAML::Node edges = root["edges"];

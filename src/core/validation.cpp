@@ -7,6 +7,7 @@
 
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/motion_parameters.hpp"
+#include "variational_formation/core/number_checks.hpp"
 #include "variational_formation/core/stability.hpp"
 #include "variational_formation/core/variational_update.hpp"
 
@@ -79,11 +80,38 @@ void validateRealTimeFactor(double realTimeFactor, double timeStep, const std::s
   }
 }
 
+void validateInitialHeadings(const Scenario& s) {
+  if (s.initialHeadings.empty()) return;
+  if (s.dimension != 2) {
+    throw InvalidInput("initial_heading: only for planar (dimension 2) unicycles, the scenario has dimension " +
+                       std::to_string(s.dimension));
+  }
+  if (static_cast<int>(s.initialHeadings.size()) != s.agentCount()) {
+    throw InvalidInput("initial_heading: expected one per agent (" + std::to_string(s.agentCount()) +
+                       "), got " + std::to_string(s.initialHeadings.size()));
+  }
+  for (std::size_t i = 0; i < s.initialHeadings.size(); ++i) {
+    const double heading = s.initialHeadings[i];
+    if (!std::isfinite(heading)) {
+      throw InvalidInput("agents[" + std::to_string(i) + "].initial_heading: must be finite, got " +
+                         formatNumber(heading));
+    }
+  }
+}
+
+double initialHeading(const Scenario& s, int id) {
+  if (id < 0 || id >= s.agentCount()) {
+    throw InvalidInput("id: must be in 0.." + std::to_string(s.agentCount() - 1) + ", got " + std::to_string(id));
+  }
+  return s.initialHeadings.empty() ? 0.0 : s.initialHeadings[static_cast<std::size_t>(id)];
+}
+
 void validateScenario(Scenario& s, bool requireBoundedSteps, const FieldNames& names) {
   validateDynamics(s.timeStep, s.dampingGain, names);
   validateSteps(s.steps, requireBoundedSteps, names.steps);
   // Formation's constructor checks the edges and the desired shape.
   const Formation formation = makeFormation(s);
+  validateInitialHeadings(s);
   s.warnings.clear();
   if (s.agentCount() >= 2 && !formation.isInfinitesimallyRigid(s.desiredPositions)) {
     s.warnings.push_back("edges: the desired graph is not infinitesimally rigid (rank " +

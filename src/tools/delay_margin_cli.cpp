@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <ostream>
 #include <sstream>
@@ -91,6 +92,14 @@ int runDelayMarginCli(int argc, const char* const* argv, std::ostream& out, std:
       return kExitOk;
     }
     const DelayCampaign campaign(scenario, settings);  // checks the settings before the scan
+    // Made before the (long) scan and campaign, so that a bad directory fails at once.
+    const std::string dir = args.text("--out-dir");
+    std::error_code made;
+    std::filesystem::create_directories(dir, made);
+    if (made || !std::filesystem::is_directory(dir, made)) {
+      throw InvalidInput("--out-dir: cannot create the directory '" + dir + "'" +
+                         (made ? ": " + made.message() : std::string()));
+    }
 
     const auto wallStart = std::chrono::steady_clock::now();
     const DelayMargin predicted =
@@ -110,7 +119,6 @@ int runDelayMarginCli(int argc, const char* const* argv, std::ostream& out, std:
     const auto end = std::chrono::steady_clock::now();
     if (progressToTerminal) err << '\n';
 
-    const std::string dir = args.text("--out-dir");
     const std::string summaryPath = dir + "/" + scenario.name + "_delay_margin.csv";
     std::ofstream summary(summaryPath);
     if (!summary) throw InvalidInput("--out-dir: cannot write '" + summaryPath + "'");

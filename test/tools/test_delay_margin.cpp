@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -95,6 +96,21 @@ TEST(DelayMarginCli, PrintsBothMarginsAndWritesTheCsvs) {
   EXPECT_EQ(summary.rfind("delay_steps,loss,runs,congruent_fraction", 0), 0u);
   EXPECT_EQ(std::count(summary.begin(), summary.end(), '\n'), 1 + 7 * 2);  // D = 0..6
   EXPECT_EQ(slurp(dir + "/hexagon_D4_P0.5.csv").rfind("run,congruent,congruent_step", 0), 0u);
+}
+
+TEST(DelayMarginCli, CreatesTheOutputDirectoryWithItsParents) {
+  const std::string dir = ::testing::TempDir() + "vf_dm_new/a/b";
+  std::remove((dir + "/hexagon_delay_margin.csv").c_str());
+  const CliResult r = call(false, {"--scenario", kConfig + "hexagon.yaml", "--kappa", "4",
+                                   "--out-dir", dir, "--runs", "1", "--steps", "200",
+                                   "--losses", "0", "--delays", "0", "0", "--threads", "1"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(slurp(dir + "/hexagon_delay_margin.csv").rfind("delay_steps,loss", 0), 0u);
+  // A directory below a regular file cannot be made: one line, status 2.
+  const std::string file = ::testing::TempDir() + "vf_dm_file";
+  std::ofstream(file) << "x\n";
+  expectBadInput(false, {"--scenario", kConfig + "hexagon.yaml", "--out-dir", file + "/sub"},
+                 "--out-dir: cannot create the directory '" + file + "/sub'");
 }
 
 TEST(DelayMarginCli, NoNeighboursIsSaid) {

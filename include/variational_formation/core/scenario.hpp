@@ -26,6 +26,9 @@ struct Scenario {
   /// The optional `manoeuvre:` schedule (doc/manoeuvres.md); empty = no command, today's run.
   /// The last segment's until is +inf when omitted.
   std::vector<ManoeuvreSegment> manoeuvre;
+  /// Initial heading [rad] of each agent's unicycle robot (field `initial_heading`, 2D only):
+  /// empty if no agent gives one, else one per agent (0 where not given).
+  std::vector<double> initialHeadings;
   /// Non-fatal findings, one line each (a non-rigid desired graph, a too large h).
   std::vector<std::string> warnings;
 

@@ -98,6 +98,14 @@ void validateScenario(Scenario& scenario, bool requireBoundedSteps = false,
  */
 void validateManoeuvre(Scenario& scenario, const Formation& formation, const FieldNames& names = {});
 
+/// The initial headings (`initial_heading`): none, or one finite value [rad] per agent, planar
+/// scenarios only. @throws InvalidInput naming the field.
+void validateInitialHeadings(const Scenario& scenario);
+
+/// Agent id's initial heading [rad] from the scenario (0 if it gives none).
+/// @throws InvalidInput on a bad id.
+double initialHeading(const Scenario& scenario, int id);
+
 /// Replacements for scenario fields (command-line flags); unset ones keep the file's value.
 struct ScenarioOverrides {
   std::optional<double> timeStep;

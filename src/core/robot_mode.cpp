@@ -1,0 +1,219 @@
+#include "variational_formation/core/robot_mode.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "variational_formation/core/delay_margin.hpp"
+#include "variational_formation/core/error.hpp"
+#include "variational_formation/core/hand_point.hpp"
+#include "variational_formation/core/number_checks.hpp"
+#include "variational_formation/core/point_robot.hpp"
+#include "variational_formation/core/timed_agent.hpp"
+#include "variational_formation/core/unicycle_robot.hpp"
+#include "variational_formation/core/validation.hpp"
+
+namespace vf {
+
+RobotLagCheck checkRobotLag(const Scenario& scenario, double lag, double tickPeriod) {
+  requireFiniteAtLeast("lag", lag, 0.0, "s");
+  requireFiniteAbove("tick period", tickPeriod, 0.0, "s");
+  const double h = scenario.timeStep;
+  RobotLagCheck check;
+  check.lagPlusTick = lag + tickPeriod;
+  // Only delays up to one past lag + tick matter: stop the scan there.
+  const long needed = static_cast<long>(std::ceil(check.lagPlusTick / h)) + 1;
+  const DelayMargin margin =
+      predictDelayMargin(makeFormation(scenario), h, scenario.dampingGain, std::min(needed, 1000L));
+  check.marginSteps = margin.margin;
+  check.capped = margin.capped;
+  check.marginSeconds = std::max(0L, margin.margin) * h;
+  check.exceeded = !margin.capped && (margin.margin < 0 || check.lagPlusTick > check.marginSeconds);
+  if (check.exceeded) {
+    check.warning = "robot lag " + formatNumber(lag) + " s plus one tick " + formatNumber(tickPeriod) +
+                    " s = " + formatNumber(check.lagPlusTick) + " s exceeds the delay margin D* = " +
+                    std::to_string(margin.margin) + " steps = " + formatNumber(check.marginSeconds) +
+                    " s (kappa " + formatNumber(scenario.dampingGain) + ", h " + formatNumber(h) +
+                    "): with odometry feedback the robots may never form the shape; a larger kappa or "
+                    "a smaller h widens the margin, or use integrated feedback (doc/robots.md)";
+  }
+  return check;
+}
+
+void correctedPosition(const std::vector<double>& integrated, const std::vector<double>& measured,
+                       double timeStep, double correctionTime, std::vector<double>& out) {
+  requireFiniteAbove("time_step", timeStep, 0.0, "s");
+  requireFiniteAtLeast("correction_time", correctionTime, 0.0, "s");
+  if (integrated.size() != measured.size()) {
+    throw InvalidInput("measured position: expected " + std::to_string(integrated.size()) + " values, got " +
+                       std::to_string(measured.size()));
+  }
+  // Exact discretisation of q' = (measured - q) / Tc over one tick.
+  const double gain = correctionTime > 0.0 ? -std::expm1(-timeStep / correctionTime) : 1.0;
+  out.resize(integrated.size());
+  for (std::size_t a = 0; a < integrated.size(); ++a) {
+    if (!std::isfinite(integrated[a]) || !std::isfinite(measured[a])) {
+      throw InvalidInput("measured position: must be finite, got " + formatNumber(measured[a]));
+    }
+    out[a] = integrated[a] + gain * (measured[a] - integrated[a]);
+  }
+}
+
+namespace {
+
+// One simulated robot as the loop sees it: its point (hand point for a unicycle).
+class LoopRobot {
+ public:
+  LoopRobot(const RobotLoopSettings& s, const std::vector<double>& start, double heading, std::uint64_t seed)
+      : settings_(s) {
+    if (s.kinematics == RobotKinematics::Holonomic) {
+      PointRobotSettings p;
+      p.lag = s.lag;
+      p.maxSpeed = s.maxSpeed;
+      p.maxAcceleration = s.maxAcceleration;
+      p.odometryNoise = s.odometryNoise;
+      point_ = std::make_unique<PointRobot>(p, start, seed);
+    } else {
+      if (start.size() != 2) throw InvalidInput("kinematics: unicycle robots need a planar scenario");
+      hand_.handOffset = s.handOffset;
+      hand_.maxSpeed = s.maxSpeed;
+      hand_.maxTurnRate = s.maxTurnRate;
+      UnicycleRobotSettings u;
+      u.lag = s.lag;
+      u.maxSpeed = s.maxSpeed;
+      u.maxTurnRate = s.maxTurnRate;
+      u.odometryNoise = s.odometryNoise;
+      u.headingNoise = s.headingNoise;
+      initialHeading_ = heading;
+      unicycle_ = std::make_unique<UnicycleRobot>(u, axleFromHandPoint(start.data(), heading, s.handOffset), seed);
+    }
+  }
+  // Odometry: the measured point; for a unicycle also the measured heading.
+  std::vector<double> measure() {
+    if (point_) return point_->measuredPosition();
+    const PlanarPose pose = unicycle_->measuredPose();
+    measuredHeading_ = pose.heading;
+    std::vector<double> p(2);
+    handPoint(pose, hand_.handOffset, p.data());
+    return p;
+  }
+  std::vector<double> truePoint() const {
+    if (point_) return point_->position();
+    std::vector<double> p(2);
+    handPoint(unicycle_->pose(), hand_.handOffset, p.data());
+    return p;
+  }
+  // A commanded velocity of the point [m/s]; for a unicycle at the last measured heading.
+  bool command(const std::vector<double>& u) {
+    if (point_) {
+      point_->setCommand(u);
+      return false;
+    }
+    const UnicycleCommand c = handPointCommand(hand_, measuredHeading_, u[0], u[1]);
+    unicycle_->setCommand(c.linear, 0.0, c.angular);
+    return c.saturated;
+  }
+  void advance(double dt) {
+    if (point_) point_->advance(dt);
+    else unicycle_->advance(dt);
+  }
+  double headingChange() const {
+    if (!unicycle_) return 0.0;
+    const double d = unicycle_->pose().heading - initialHeading_;
+    return std::abs(std::atan2(std::sin(d), std::cos(d)));
+  }
+
+ private:
+  RobotLoopSettings settings_;
+  HandPointSettings hand_;
+  std::unique_ptr<PointRobot> point_;
+  std::unique_ptr<UnicycleRobot> unicycle_;
+  double measuredHeading_ = 0.0;
+  double initialHeading_ = 0.0;
+};
+
+// max over all pairs of | |p_i - p_j| - |q*_i - q*_j| | [m].
+double pairError(const Scenario& s, const std::vector<std::vector<double>>& points) {
+  double worst = 0.0;
+  const int n = s.agentCount();
+  for (int i = 0; i < n; ++i) {
+    for (int j = i + 1; j < n; ++j) {
+      double a = 0.0;
+      for (int c = 0; c < s.dimension; ++c) {
+        const double d = points[i][c] - points[j][c];
+        a += d * d;
+      }
+      const double desired = (s.desiredPositions.col(i) - s.desiredPositions.col(j)).norm();
+      worst = std::max(worst, std::abs(std::sqrt(a) - desired));
+    }
+  }
+  return worst;
+}
+
+}  // namespace
+
+RobotLoopResult runRobotLoop(const Scenario& scenario, const RobotLoopSettings& s) {
+  if (scenario.steps < 1) throw InvalidInput("steps: the closed loop needs a bounded run, got 0");
+  requireFiniteAtLeast("correction_time", s.correctionTime, 0.0, "s");
+  requireFiniteAbove("tolerance", s.tolerance, 0.0, "m");
+  const int n = scenario.agentCount();
+  const double h = scenario.timeStep;
+  const double kp = s.trackingGain >= 0.0 ? s.trackingGain : 1.0 / (4.0 * (s.lag + h));
+  std::vector<TimedAgent> agents;
+  std::vector<LoopRobot> robots;
+  for (int i = 0; i < n; ++i) {
+    agents.emplace_back(scenario, i, 1.0);
+    const std::vector<double> start(scenario.initialPositions.col(i).data(),
+                                    scenario.initialPositions.col(i).data() + scenario.dimension);
+    const double heading = scenario.initialHeadings.empty() ? drawInitialHeading(s.headingSeed, i)
+                                                            : initialHeading(scenario, i);
+    robots.emplace_back(s, start, heading, s.seed + static_cast<std::uint64_t>(i));
+  }
+  RobotLoopResult result;
+  const long lastSecond = std::max(0L, scenario.steps - static_cast<long>(std::lround(1.0 / h)));
+  std::vector<double> start;
+  for (long k = 0; k < scenario.steps; ++k) {
+    const double now = k * h;
+    // Every agent's newest state, as published at the previous tick.
+    for (int i = 0; i < n; ++i) {
+      for (int j : agents[i].neighbourIds()) {
+        agents[i].receive(j, agents[j].step(), agents[j].position(), agents[j].previousPosition(), now);
+      }
+    }
+    for (int i = 0; i < n; ++i) {
+      const std::vector<double> measured = robots[i].measure();
+      if (s.feedback == RobotFeedback::Odometry) {
+        agents[i].setMeasuredPosition(measured);
+      } else {
+        correctedPosition(agents[i].position(), measured, h, s.correctionTime, start);
+        agents[i].setMeasuredPosition(start);
+      }
+      agents[i].tick(now);
+      std::vector<double> u = agents[i].commandedVelocity();
+      if (s.feedback == RobotFeedback::Integrated) {
+        // Track q_k, where the robot should be now, with the velocity as feed-forward.
+        const std::vector<double>& target = agents[i].previousPosition();
+        for (std::size_t a = 0; a < u.size(); ++a) u[a] += kp * (target[a] - measured[a]);
+      }
+      if (robots[i].command(u)) ++result.saturatedCommands;
+    }
+    std::vector<std::vector<double>> points;
+    for (LoopRobot& robot : robots) {
+      robot.advance(h);
+      points.push_back(robot.truePoint());
+    }
+    const double error = pairError(scenario, points);
+    if (error <= s.tolerance) {
+      if (result.convergedStep < 0) result.convergedStep = k + 1;
+    } else {
+      result.convergedStep = -1;
+    }
+    if (k >= lastSecond) result.maxErrorLastSecond = std::max(result.maxErrorLastSecond, error);
+    result.finalError = error;
+  }
+  result.convergedTime = result.convergedStep >= 0 ? result.convergedStep * h : -1.0;
+  for (const LoopRobot& robot : robots) result.maxHeadingChange = std::max(result.maxHeadingChange, robot.headingChange());
+  return result;
+}
+
+}  // namespace vf
