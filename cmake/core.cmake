@@ -20,6 +20,7 @@ add_library(variational_formation_core
   src/core/timed_agent.cpp
   src/core/point_robot.cpp
   src/core/record_ledger.cpp
+  src/core/protocol/recovery.cpp
 )
 target_include_directories(variational_formation_core PUBLIC
   $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/include>)
