@@ -120,9 +120,9 @@ TEST(StepAssembler, HandsOutWholeStepsInOrderOnce) {
 // ---- the run referee, event by event ----
 
 TEST(LockstepReferee, ProgressGoesOutWhenAgentsMayWaitAtTheAllowedStep) {
-  // The progress-throttling deadlock: a progress every quarter window only, so with the recorder
-  // one step behind, the monitor completed the allowed step while the allowed step it would
-  // publish grew by less than a quarter window: nobody moved again.
+  // The throttling rule (commit a83a62b, "a throttling deadlock"): a progress goes out every
+  // quarter window only, but also whenever the agents may already wait at the allowed step;
+  // without that, agents that reached it idle until the window moved a whole quarter.
   const Scenario s = shortScenario("square", 40);
   test::Referee r(s, 8, true, false);
   const auto offerStep = [&](long k) {
@@ -138,10 +138,19 @@ TEST(LockstepReferee, ProgressGoesOutWhenAgentsMayWaitAtTheAllowedStep) {
   ASSERT_TRUE(r.updateProgress(true));
   EXPECT_EQ(r.progressNow().allowedStep, 8);
   for (long k = 1; k <= 8; ++k) offerStep(k);  // the agents stop at 8
-  r.recorderProgress(7, false);                // allowed would be 15: less than a quarter window more
+  r.recorderProgress(1, false);                // allowed 9: less than a quarter window (2) more
   ASSERT_TRUE(r.updateProgress(true)) << "agents wait at step 8 and no progress goes out";
-  EXPECT_EQ(r.progressNow().allowedStep, 15);
-  EXPECT_EQ(r.waitingFor("rec"), "step 9 of agent_0, agent_1, agent_2, agent_3");
+  EXPECT_EQ(r.progressNow().allowedStep, 9);
+  EXPECT_EQ(r.progressNow().completedStep, 1);
+  r.recorderProgress(2, false);
+  EXPECT_FALSE(r.updateProgress(true));  // allowed 10: not a quarter more, and nobody waits at 9 yet
+  offerStep(9);
+  EXPECT_TRUE(r.updateProgress(true));   // now they do
+  EXPECT_EQ(r.progressNow().allowedStep, 10);
+  r.recorderProgress(9, false);
+  ASSERT_TRUE(r.updateProgress(true));
+  EXPECT_EQ(r.progressNow().allowedStep, 17);
+  EXPECT_EQ(r.waitingFor("rec"), "step 10 of agent_0, agent_1, agent_2, agent_3");
 }
 
 TEST(LockstepReferee, StatesPastTheAllowedStepAndRepeatsAreRefused) {
