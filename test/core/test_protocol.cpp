@@ -371,7 +371,7 @@ TEST(ProtocolRandom, SeededInterleavingsRecordEveryStateOnceExactly) {
   cases[2].second = 9;
   cases.push_back({generated({"--shape", "ring", "--agents", "9", "--chords", "1", "--steps", "12"}), 3});
   cases.push_back({generated({"--shape", "henneberg", "--agents", "7", "--dimension", "3", "--steps", "12"}), 5});
-  long interleavings = 0, events = 0;
+  long interleavings = 0;
   const unsigned runs = 500;  // per formation
   for (std::size_t c = 0; c < cases.size(); ++c) {
     for (unsigned seed = 1; seed <= runs; ++seed) {
@@ -386,7 +386,6 @@ TEST(ProtocolRandom, SeededInterleavingsRecordEveryStateOnceExactly) {
       }
     }
   }
-  (void)events;
   std::printf("protocol: %ld seeded interleavings over %zu formations\n", interleavings, cases.size());
 }
 
