@@ -2,13 +2,11 @@
 
 #include <algorithm>
 
-#include <geometry_msgs/TransformStamped.h>
 #include <ros/callback_queue.h>
 
 #include "variational_formation/core/validation.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/participants.hpp"
-#include "variational_formation/ros/service_call.hpp"
 
 namespace vf {
 
@@ -150,14 +148,7 @@ void AgentNode::publish() {
   statePub_.publish(published);
   history_.push_back(published);
 
-  geometry_msgs::TransformStamped t;
-  t.header = msg.header;
-  t.child_frame_id = frame_;
-  t.transform.translation.x = msg.position[0];
-  t.transform.translation.y = msg.position[1];
-  t.transform.translation.z = msg.position.size() > 2 ? msg.position[2] : 0.0;
-  t.transform.rotation.w = 1.0;
-  tf_.sendTransform(t);
+  tf_.sendTransform(frameAt(msg.header, frame_, msg.position));
 }
 
 std::string AgentNode::waitingFor() const {
@@ -184,24 +175,7 @@ void AgentNode::reportWaiting() {
 }
 
 AgentNode::Recovery AgentNode::askHolders() const {
-  Recovery r;
-  std::vector<std::string> holders;
-  for (int j : agent_->neighbourIds()) holders.push_back(agentNodeName(nh_, j));
-  holders.push_back(monitor_);  // the fallback: it holds everyone's newest state
-  std::vector<std::string> services;
-  for (const std::string& holder : holders) services.push_back(holder + "/recall");
-  std::vector<RecallState> calls(holders.size());
-  for (RecallState& call : calls) call.request.id = static_cast<uint32_t>(agent_->id());
-  const std::vector<bool> answered = callAllWithTimeout(services, calls, 2.0);
-  for (std::size_t k = 0; k < holders.size(); ++k) {
-    if (!answered[k] || !calls[k].response.held) continue;
-    if (calls[k].response.step > r.step) {
-      r.step = calls[k].response.step;
-      r.found = calls[k].response;
-      r.from = holders[k];
-    }
-  }
-  return r;
+  return recallNewest(nh_, agent_->id(), agent_->neighbourIds(), monitor_);
 }
 
 void AgentNode::resume(const Recovery& r) {

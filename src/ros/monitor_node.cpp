@@ -9,6 +9,7 @@
 #include <ros/master.h>
 
 #include "variational_formation/core/number_checks.hpp"
+#include "variational_formation/core/protocol/recovery.hpp"
 #include "variational_formation/ros/markers.hpp"
 #include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/parameters.hpp"
@@ -79,6 +80,8 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   }
   recording_ = !recorder.empty();
   if (recording_) {
+    const std::string disagree = protocol::checkBuffers(window_);
+    if (!disagree.empty()) throw InvalidInput(disagree);
     recorder_.node = participantName(nh, recorder);
     recorderSub_ = nh.subscribe<RunProgress>(
         recorder + "/progress", 10,
@@ -449,22 +452,17 @@ void MonitorNode::recover() {
   std::vector<int> all;
   for (std::size_t i = 0; i < agents_.size(); ++i) all.push_back(static_cast<int>(i));
   const std::vector<RecallHistory::Response> held = fetchHistories(all);
-  long resumeAt = -1, since = -1;
-  for (const auto& h : held) {
-    if (h.has_progress && h.progress.completed_step + 1 > resumeAt) {
-      resumeAt = h.progress.completed_step + 1;
-      since = h.progress.converged_step;
-    }
-  }
-  if (resumeAt <= 0) return;  // a new run
+  std::vector<protocol::ProgressAnswer> answers;
+  for (const auto& h : held) answers.push_back({true, static_cast<bool>(h.has_progress), h.progress.completed_step, h.progress.converged_step});
+  const protocol::MonitorResume r = protocol::chooseMonitorResume(answers, window_);
+  if (!r.resumes()) return;  // a new run
+  const long resumeAt = r.step, since = r.congruentSince;
   monitor_->startAt(resumeAt, since);
   reportedConvergence_ = since >= 0 ? since : -2;
   firstStepAt_ = startedAt_ = ros::WallTime::now();
   progress_.state = RunProgress::RUNNING;
   progress_.completed_step = resumeAt - 1;
-  // The old monitor may have allowed up to its completed step (at most a quarter window past
-  // what the agents heard) plus the window.
-  acceptUpTo_ = resumeAt + window_ + window_ / 4;
+  acceptUpTo_ = r.acceptUpTo;
   for (std::size_t i = 0; i < held.size(); ++i) {
     agents_[i].seen = true;
     addHistory(static_cast<int>(i), held[i]);

@@ -16,8 +16,46 @@
 #include <ros/master.h>
 
 #include "variational_formation/core/error.hpp"
+#include "variational_formation/core/protocol/recovery.hpp"
+#include "variational_formation/ros/service_call.hpp"
 
 namespace vf {
+
+geometry_msgs::TransformStamped frameAt(const std_msgs::Header& header, const std::string& child,
+                                        const std::vector<double>& position) {
+  geometry_msgs::TransformStamped t;
+  t.header = header;
+  t.child_frame_id = child;
+  t.transform.translation.x = position.size() > 0 ? position[0] : 0.0;
+  t.transform.translation.y = position.size() > 1 ? position[1] : 0.0;
+  t.transform.translation.z = position.size() > 2 ? position[2] : 0.0;
+  t.transform.rotation.w = 1.0;
+  return t;
+}
+
+Recalled recallNewest(const ros::NodeHandle& nh, int id, const std::vector<int>& neighbours, const std::string& monitor) {
+  std::vector<std::string> holders;
+  for (int j : neighbours) holders.push_back(agentNodeName(nh, j));
+  holders.push_back(monitor);
+  std::vector<std::string> services;
+  for (const std::string& holder : holders) services.push_back(holder + "/recall");
+  std::vector<variational_formation::RecallState> calls(holders.size());
+  for (auto& call : calls) call.request.id = static_cast<uint32_t>(id);
+  const std::vector<bool> answered = callAllWithTimeout(services, calls, 2.0);
+  std::vector<protocol::RecallAnswer> answers;
+  for (std::size_t k = 0; k < holders.size(); ++k) {
+    answers.push_back({answered[k], answered[k] && calls[k].response.held, static_cast<long>(calls[k].response.step)});
+  }
+  Recalled r;
+  const int k = protocol::chooseAgentResume(answers);
+  if (k >= 0) {
+    r.step = calls[static_cast<std::size_t>(k)].response.step;
+    r.found = calls[static_cast<std::size_t>(k)].response;
+    r.from = holders[static_cast<std::size_t>(k)];
+  }
+  return r;
+}
+
 
 std::string agentNodeName(const ros::NodeHandle& nh, int id) {
   return participantName(nh, "agent_" + std::to_string(id));

@@ -6,6 +6,7 @@
 #include <ros/callback_queue.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include "variational_formation/core/protocol/recovery.hpp"
 #include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/participants.hpp"
@@ -14,10 +15,10 @@
 namespace vf {
 
 namespace {
-constexpr uint32_t kQueue = 100000;  // far more than the monitor's window lets the agents run ahead
-// Each agent's newest states kept to compare repeats with: repeats are of steps at most one
-// window (the monitor's ~window, 100 by default) behind an agent's newest.
-constexpr long kKeptSteps = 1024;
+// Queues far longer than the monitor's window lets the agents run ahead, and each agent's newest
+// states kept to compare repeats with; the monitor checks its ~window against both at start-up.
+const protocol::RecorderBuffers kBuffers;
+const uint32_t kQueue = static_cast<uint32_t>(kBuffers.queue);
 
 /// Bag time of a message stamped with simulated time t_k (a bag cannot hold time 0).
 ros::Time bagTime(const ros::Time& stamp) { return std::max(stamp, ros::TIME_MIN); }
@@ -30,10 +31,11 @@ RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh),
   managers_ = agentManagers(nh, pnh);
   markerEvery_ = optionalParam(pnh, "marker_every", 1);
   if (markerEvery_ < 1) throw InvalidInput("~marker_every: must be >= 1, got " + std::to_string(markerEvery_));
-  steps_ = scenario.steps;
+  lastStep_ = scenario.steps;
   timeStep_ = scenario.timeStep;
   const int n = scenario.agentCount();
-  states_ = RecordLedger(n, kKeptSteps);
+  states_ = RecordLedger(n, kBuffers.keptSteps);
+  steps_ = std::make_unique<Steps>(n, [this](long step) { return needsMarkers(step); });
   const double splitMb = optionalParam(pnh, "split_size", 256.0);
   const double maxMb = optionalParam(pnh, "max_size", 1024.0);
   if (!(splitMb >= 0.0 && splitMb < 1e9)) throw InvalidInput("~split_size: must be in [0, 1e9) MB, got " + std::to_string(splitMb));
@@ -73,7 +75,7 @@ RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh),
   progressPub_ = pnh.advertise<RunProgress>("progress", 10, true);
   progress_.state = RunProgress::WAITING;
   progress_.completed_step = -1;
-  ROS_INFO("recorder: writing %s (%d agents, %ld steps), monitor %s, %s, %s", path_.c_str(), n, steps_,
+  ROS_INFO("recorder: writing %s (%d agents, %ld steps), monitor %s, %s, %s", path_.c_str(), n, lastStep_,
            monitor_.c_str(), maxMb > 0 ? ("at most " + std::to_string(static_cast<long>(maxMb)) + " MB").c_str() : "no size limit",
            splitMb > 0 ? ("files of " + std::to_string(static_cast<long>(splitMb)) + " MB").c_str() : "one file");
 }
@@ -191,51 +193,26 @@ void RecorderNode::record(int agent, const AgentState::ConstPtr& msg) {
     uncompared_ += arrival == RecordLedger::Arrival::Unchecked;
     return;
   }
-  if (msg->step <= writtenThrough_) return;  // cannot happen: a written step had all its states
-  Pending& p = pendingAt(msg->step);
-  p.states[static_cast<std::size_t>(agent)] = msg;
-  ++p.stateCount;
-  flush();
-}
-
-RecorderNode::Pending& RecorderNode::pendingAt(long step) {
-  auto it = pending_.find(step);
-  if (it == pending_.end()) {
-    it = pending_.emplace(step, Pending()).first;
-    it->second.states.resize(static_cast<std::size_t>(states_.agentCount()));
-  }
-  return it->second;
+  if (steps_->addState(agent, msg->step, msg)) flush();  // refused: cannot happen, a written step had all its states
 }
 
 bool RecorderNode::needsMarkers(long step) const {
-  return step % markerEvery_ == 0 || (steps_ > 0 && step == steps_);
+  return step % markerEvery_ == 0 || (lastStep_ > 0 && step == lastStep_);
 }
 
 void RecorderNode::flush() {
   // Steps are written whole and in order, so the bag's messages are in time order: readers that
   // trust it (Python's rosbag merges chunks assuming it) see every stream in step order.
-  while (!pending_.empty() && pending_.begin()->first == writtenThrough_ + 1) {
-    const long step = pending_.begin()->first;
-    Pending& p = pending_.begin()->second;
-    if (p.stateCount < states_.agentCount() || !p.status || (needsMarkers(step) && !p.markers)) break;
-    for (std::size_t i = 0; i < p.states.size(); ++i) {
-      const AgentState& msg = *p.states[i];
+  for (const Steps::Step& step : steps_->takeWhole()) {
+    for (std::size_t i = 0; i < step.states.size(); ++i) {
+      const AgentState& msg = *step.states[i];
       write(stateTopics_[i], msg, msg.header.stamp);
       tf2_msgs::TFMessage tf;
-      tf.transforms.resize(1);
-      auto& t = tf.transforms[0];
-      t.header = msg.header;
-      t.child_frame_id = frameIds_[i];
-      t.transform.translation.x = msg.position.size() > 0 ? msg.position[0] : 0.0;
-      t.transform.translation.y = msg.position.size() > 1 ? msg.position[1] : 0.0;
-      t.transform.translation.z = msg.position.size() > 2 ? msg.position[2] : 0.0;
-      t.transform.rotation.w = 1.0;
+      tf.transforms.push_back(frameAt(msg.header, frameIds_[i], msg.position));
       write("/tf", tf, msg.header.stamp);
     }
-    write(statusTopic_, *p.status, p.status->header.stamp);
-    if (p.markers) write(markersTopic_, *p.markers, markersStamp(*p.markers));
-    pending_.erase(pending_.begin());
-    writtenThrough_ = step;
+    write(statusTopic_, *step.status, step.status->header.stamp);
+    if (step.hasMarkers) write(markersTopic_, *step.markers, markersStamp(*step.markers));
   }
   report();
 }
@@ -243,11 +220,7 @@ void RecorderNode::flush() {
 void RecorderNode::onStatus(const ros::MessageEvent<FormationStatus const>& event) {
   if (!fromOwner(event, monitor_)) return;
   const FormationStatus::ConstPtr msg = event.getConstMessage();
-  if (msg->step <= writtenThrough_) return;  // republished: written once
-  Pending& p = pendingAt(msg->step);
-  if (p.status) return;
-  p.status = msg;
-  flush();
+  if (steps_->addStatus(msg->step, msg)) flush();  // refused if republished: written once
 }
 
 ros::Time RecorderNode::markersStamp(const visualization_msgs::MarkerArray& msg) {
@@ -257,12 +230,8 @@ ros::Time RecorderNode::markersStamp(const visualization_msgs::MarkerArray& msg)
 void RecorderNode::onMarkers(const ros::MessageEvent<visualization_msgs::MarkerArray const>& event) {
   if (!fromOwner(event, monitor_)) return;
   const auto msg = event.getConstMessage();
-  const long step = std::lround(markersStamp(*msg).toSec() / timeStep_);
-  if (step <= writtenThrough_ || !needsMarkers(step)) return;  // republished: written once
-  Pending& p = pendingAt(step);
-  if (p.markers) return;
-  p.markers = msg;
-  flush();
+  const long step = protocol::stepOfStamp(markersStamp(*msg).toSec(), timeStep_);
+  if (steps_->addMarkers(step, msg)) flush();  // refused if republished: written once
 }
 
 void RecorderNode::onMonitorProgress(const ros::MessageEvent<RunProgress const>& event) {
@@ -277,12 +246,12 @@ void RecorderNode::onMonitorProgress(const ros::MessageEvent<RunProgress const>&
 void RecorderNode::report() {
   if (progress_.state == RunProgress::FAILED || progress_.state == RunProgress::FINISHED) return;
   // Complete up to k: every agent's state, the status and the markers of steps 0..k are written.
-  const long complete = writtenThrough_;
+  const long complete = steps_->handedOutThrough();
   if (complete <= progress_.completed_step) return;
   progress_.completed_step = complete;
   progress_.header.stamp.fromSec(static_cast<double>(complete) * timeStep_);
   progress_.state = RunProgress::RUNNING;
-  if (steps_ > 0 && complete >= steps_) {
+  if (lastStep_ > 0 && complete >= lastStep_) {
     close("complete");
     progress_.state = RunProgress::FINISHED;
   }

@@ -11,7 +11,6 @@
 #include "variational_formation/core/validation.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/participants.hpp"
-#include "variational_formation/ros/service_call.hpp"
 
 namespace vf {
 
@@ -285,33 +284,16 @@ void TimedAgentNode::reportWaiting() {
 }
 
 void TimedAgentNode::recover() {
-  std::vector<std::string> holders;
-  for (int j : agent_->neighbourIds()) holders.push_back(agentNodeName(nh_, j));
-  holders.push_back(monitor_);
-  std::vector<std::string> services;
-  for (const std::string& holder : holders) services.push_back(holder + "/recall");
-  std::vector<RecallState> calls(holders.size());
-  for (RecallState& call : calls) call.request.id = static_cast<uint32_t>(agent_->id());
-  const std::vector<bool> answered = callAllWithTimeout(services, calls, 2.0);
-  long best = 0;
-  std::size_t from = 0;
-  for (std::size_t k = 0; k < holders.size(); ++k) {
-    if (answered[k] && calls[k].response.held && calls[k].response.step > best) {
-      best = calls[k].response.step;
-      from = k;
-    }
-  }
-  if (best <= 0) {
+  const Recalled r = recallNewest(nh_, agent_->id(), agent_->neighbourIds(), monitor_);
+  if (r.step <= 0) {
     ROS_INFO("%s: nobody holds a state of mine beyond step 0: starting from the scenario", name_.c_str());
     return;
   }
   try {
-    agent_->restore(best, calls[from].response.position);
-    ROS_INFO("%s: recovered step %ld from %s; restarting from rest there", name_.c_str(), best,
-             holders[from].c_str());
+    agent_->restore(r.step, r.found.position);
+    ROS_INFO("%s: recovered step %ld from %s; restarting from rest there", name_.c_str(), r.step, r.from.c_str());
   } catch (const std::exception& e) {
-    ROS_WARN("%s: cannot restore from %s (%s): starting from the scenario", name_.c_str(), holders[from].c_str(),
-             e.what());
+    ROS_WARN("%s: cannot restore from %s (%s): starting from the scenario", name_.c_str(), r.from.c_str(), e.what());
   }
 }
 

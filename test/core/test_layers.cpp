@@ -19,7 +19,7 @@ bool allowedInCore(const std::string& target) {
   static const std::regex standardLibrary("[a-z_0-9]+");  // <vector>, <cmath>: no '/' or '.'
   static const std::regex eigen("(Eigen|unsupported/Eigen)/[A-Za-z0-9_]+");
   static const std::regex yamlCpp("yaml-cpp/[A-Za-z0-9_/]+\\.h");
-  static const std::regex core("variational_formation/core/[a-z_0-9]+\\.hpp");
+  static const std::regex core("variational_formation/core/([a-z_0-9]+/)?[a-z_0-9]+\\.hpp");  // and core/protocol/
   return std::regex_match(target, standardLibrary) || std::regex_match(target, eigen) ||
          std::regex_match(target, yamlCpp) || std::regex_match(target, core);
 }

@@ -13,6 +13,7 @@
 #include "variational_formation/RecallHistory.h"
 #include "variational_formation/RecallState.h"
 #include "variational_formation/RunProgress.h"
+#include "variational_formation/ros/participants.hpp"
 #include "variational_formation/core/lockstep_agent.hpp"
 
 namespace vf {
@@ -45,11 +46,7 @@ using variational_formation::RunProgress;
 class AgentNode {
  public:
   /// What the holders (neighbours, then the monitor) answered about this agent's newest state.
-  struct Recovery {
-    long step = -1;  // the highest step held, -1 if none
-    RecallState::Response found;
-    std::string from;
-  };
+  using Recovery = Recalled;
 
   /// Reads and checks the parameters and the scenario, advertises the state topic and the
   /// recall and history services (answered on nh's callback queue). Callbacks run on nh's

@@ -4,9 +4,11 @@
 #include <string>
 #include <vector>
 
+#include <geometry_msgs/TransformStamped.h>
 #include <ros/ros.h>
 
 #include "variational_formation/AgentState.h"
+#include "variational_formation/RecallState.h"
 #include "variational_formation/RunProgress.h"
 #include "variational_formation/core/scenario.hpp"
 
@@ -18,6 +20,11 @@ std::string agentNodeName(const ros::NodeHandle& nh, int id);
 /// The prefix of frame names in the namespace of `nh`: "formation/" in /formation, "" in the
 /// root namespace (which a nodelet's handle spells "" and a node's "/").
 std::string framePrefix(const ros::NodeHandle& nh);
+
+/// The tf of a frame `child` at position (x, y, z) of header.frame_id, not rotated: the one
+/// place that builds an agent's or a robot's transform.
+geometry_msgs::TransformStamped frameAt(const std_msgs::Header& header, const std::string& child,
+                                        const std::vector<double>& position);
 
 /**
  * loadScenario(path), parsed and checked once per content in this process: the agents of one
@@ -33,6 +40,20 @@ void subscribeToFormation(
     const std::function<void(int, const ros::MessageEvent<variational_formation::AgentState const>&)>& onState,
     const std::function<void(const ros::MessageEvent<variational_formation::RunProgress const>&)>& onProgress,
     std::vector<ros::Subscriber>& states, ros::Subscriber& progress);
+
+/// Where a restarting agent resumes: the newest of its states held by a neighbour or the monitor.
+struct Recalled {
+  long step = -1;  ///< the step found; -1 if nobody holds one beyond step 0
+  variational_formation::RecallState::Response found;
+  std::string from;  ///< the holder's node name
+};
+
+/**
+ * Asks agent `id`'s neighbours, then the monitor (the fallback: it holds everyone's newest
+ * state), for their `~recall` of it, at once and for 2 s at most, and picks the answer with
+ * protocol::chooseAgentResume. Touches nothing that callbacks change.
+ */
+Recalled recallNewest(const ros::NodeHandle& nh, int id, const std::vector<int>& neighbours, const std::string& monitor);
 
 /// Full name of a participant node given relative to the namespace of `nh` (e.g. "monitor").
 std::string participantName(const ros::NodeHandle& nh, const std::string& relative);

@@ -1,6 +1,6 @@
 #pragma once
 
-#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -12,6 +12,7 @@
 #include "variational_formation/FormationStatus.h"
 #include "variational_formation/RecallHistory.h"
 #include "variational_formation/RunProgress.h"
+#include "variational_formation/core/protocol/step_assembler.hpp"
 #include "variational_formation/core/record_ledger.hpp"
 #include "variational_formation/core/scenario.hpp"
 
@@ -58,14 +59,8 @@ class RecorderNode {
   void onState(int agent, const ros::MessageEvent<AgentState const>& event);
   /// A state from the owner's topic or a fetched history: held until its step is written.
   void record(int agent, const AgentState::ConstPtr& msg);
-  /// What has arrived of a step not yet written.
-  struct Pending {
-    std::vector<AgentState::ConstPtr> states;  // by agent
-    int stateCount = 0;
-    FormationStatus::ConstPtr status;
-    visualization_msgs::MarkerArray::ConstPtr markers;
-  };
-  Pending& pendingAt(long step);
+  using Steps = protocol::StepAssembler<AgentState::ConstPtr, FormationStatus::ConstPtr,
+                                        visualization_msgs::MarkerArray::ConstPtr>;
   /// Writes every complete step after writtenThrough_, in order, then reports.
   void flush();
   /// The monitor publishes the markers of every marker_every-th step and of the last one.
@@ -89,13 +84,14 @@ class RecorderNode {
   std::vector<ros::Subscriber> subs_;
   ros::Publisher progressPub_;
   RunProgress progress_;
-  long steps_ = 0;
+  long lastStep_ = 0;  // the scenario's steps (0: unbounded)
   double timeStep_ = 0.0;
   std::vector<std::string> owners_;
   std::vector<std::string> managers_;  // ~agent_manager: nodelet managers of agents
   RecordLedger states_;  // each state is held once; repeats are compared with it
-  std::map<long, Pending> pending_;  // at most the window of steps after writtenThrough_
-  long writtenThrough_ = -1;  // every stream of steps 0..this is in the bag (or past its size limit)
+  /// Steps not yet written (at most protocol::recorderLead of them); every stream of the steps it
+  /// handed out is in the bag (or past its size limit).
+  std::unique_ptr<Steps> steps_;
   long markerEvery_ = 1;
   long written_ = 0, repeats_ = 0, uncompared_ = 0, dropped_ = 0;
   bool open_ = false;
