@@ -27,6 +27,7 @@ def main():
     parser.add_argument("--prefix", default=None)
     parser.add_argument("--commands", default=None)
     args = parser.parse_args()
+    args.scenario = data.scenario_path(args.scenario)
     scenario = data.read_scenario(args.scenario)
     q = data.read_trajectory(args.traj, scenario.n, scenario.dimension, f"the scenario {scenario.name}")
     m = data.read_metrics(args.metrics)

@@ -88,12 +88,21 @@ class ScenarioNames(unittest.TestCase):
         plot = run("/usr/bin/python3", os.path.join(SOURCE, "scripts", "plot_roa.py"), "--roa", "roa.csv",
                    "--scenario", "hexagon", "--agent", "1", "--out", "roa.png")
         self.assertEqual(plot.returncode, 0, plot.stderr)
-        import roslib.packages
-        simulate = roslib.packages.find_node(PKG, "simulate")[0]
+        where = run("rosrun", "--prefix", "echo", PKG, "simulate")  # the path rosrun would run
+        self.assertEqual(where.returncode, 0, where.stderr)
+        simulate = where.stdout.strip()
         euler = run("/usr/bin/python3", os.path.join(SOURCE, "scripts", "euler_comparison.py"), "--scenario", "square",
                     "--duration", "0.1", "--out-dir", "euler", "--simulate", simulate)
         self.assertEqual(euler.returncode, 0, euler.stderr)
         self.assertTrue(os.path.isfile(os.path.join(self.tmp, "euler", "euler_comparison.png")))
+        # A manoeuvre scenario by name: simulate and plot_simulation, which also reads its schedule.
+        sim = run("rosrun", PKG, "simulate", "--scenario", "hexagon_manoeuvre", "--steps", "40", "--out", "m.csv",
+                  "--metrics", "mm.csv")
+        self.assertEqual(sim.returncode, 0, sim.stderr)
+        plot = run("/usr/bin/python3", os.path.join(SOURCE, "scripts", "plot_simulation.py"), "--scenario",
+                   "hexagon_manoeuvre", "--traj", "m.csv", "--metrics", "mm.csv", "--out-dir", "sim")
+        self.assertEqual(plot.returncode, 0, plot.stderr)
+        self.assertTrue(os.path.isfile(os.path.join(self.tmp, "sim", "hexagon_manoeuvre_manoeuvre.png")))
 
 
 if __name__ == "__main__":
