@@ -14,16 +14,19 @@ from variational_formation.cli import fail
 TRAJECTORY_HEADER = "step,t,agent,x,y,z"
 METRICS_HEADER = ("step,t,energy,max_distance_error,px,py,pz,ax,ay,az,"
                   "cvx,cvy,cvz,wx,wy,wz,scale_error")
+# metrics.csv as simulate wrote it before the tracking columns; still read (tracking = NaN).
+METRICS_HEADER_WITHOUT_TRACKING = "step,t,energy,max_distance_error,px,py,pz,ax,ay,az"
 COMMANDS_HEADER = "step,vx,vy,vz,wx,wy,wz,scale"
 ROA_HEADER = "ix,iy,x,y,converged,converged_step,diverged"
 
 
-def load_csv(path, header):
-    """The rows of a CSV file whose first line must be `header`, as a 2D array; fail() if not."""
+def load_csv(path, header, *older_headers):
+    """The rows of a CSV file whose first line must be `header` (or one of `older_headers`), as a
+    2D array; fail() if not."""
     try:
         with open(path) as f:
             first = f.readline().strip()
-        if first != header:
+        if first != header and first not in older_headers:
             fail(f"{path}: expected header '{header}', got '{first}'")
         return np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
     except (OSError, ValueError) as e:
@@ -59,7 +62,9 @@ def bag_parts(path):
 def read_metrics(path):
     """simulate's metrics.csv: t, energy, max_distance_error, p[k, 3], a[k, 3], and the tracking
     columns: centroid velocity cv[k, 3], rotation rate w[k, 3], mean scale error scale_error[k]."""
-    m = load_csv(path, METRICS_HEADER)
+    m = load_csv(path, METRICS_HEADER, METRICS_HEADER_WITHOUT_TRACKING)
+    if m.shape[1] == 10:
+        m = np.hstack([m, np.full((m.shape[0], 7), np.nan)])
     return types.SimpleNamespace(t=m[:, 1], energy=m[:, 2], error=m[:, 3], p=m[:, 4:7], a=m[:, 7:10],
                                  cv=m[:, 10:13], w=m[:, 13:16], scale_error=m[:, 16])
 

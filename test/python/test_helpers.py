@@ -43,6 +43,19 @@ class DataTest(TempDirTestCase):
         np.testing.assert_array_equal(m.error, [0.3, 0.2])
         np.testing.assert_array_equal(m.p[1], [7, 8, 9])
         np.testing.assert_array_equal(m.a[0], [4, 5, 6])
+        self.assertTrue(np.all(np.isnan(m.cv)) and np.all(np.isnan(m.scale_error)))  # written before tracking
+
+    def test_metrics_tracking_columns(self):
+        path = self.write("m.csv", """\
+            step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error
+            0,0,2.5,0.3,1,2,3,4,5,6,0.1,0.2,0,0,0,0.5,0.01
+            1,0.5,1.5,0.2,7,8,9,10,11,12,0.3,0.4,0,0,0,0.6,0.02
+            """)
+        m = data.read_metrics(path)
+        np.testing.assert_array_equal(m.a[1], [10, 11, 12])
+        np.testing.assert_array_equal(m.cv[1], [0.3, 0.4, 0])
+        np.testing.assert_array_equal(m.w[0], [0, 0, 0.5])
+        np.testing.assert_array_equal(m.scale_error, [0.01, 0.02])
 
     def test_scenario_fields(self):
         s = data.read_scenario(os.path.join(REPO, "config", "hexagon.yaml"))
