@@ -76,6 +76,9 @@ void AgentNode::onProgress(const ros::MessageEvent<RunProgress const>& event) {
     return;
   }
   const RunProgress& p = *event.getConstMessage();
+  // Once its run is over, an agent keeps that run's final word: a monitor started later (which
+  // says that the run is over) does not change it.
+  if (exitStatus_ >= 0) return;
   if (!hasProgress_ || p.completed_step >= lastProgress_.completed_step) {
     lastProgress_ = p;
     hasProgress_ = true;

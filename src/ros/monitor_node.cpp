@@ -7,6 +7,7 @@
 
 #include <ros/callback_queue.h>
 #include <ros/master.h>
+#include <rosgraph_msgs/Clock.h>
 
 #include "variational_formation/core/number_checks.hpp"
 #include "variational_formation/core/protocol/recovery.hpp"
@@ -56,6 +57,10 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
     requireFiniteAbove("~real_time_factor (timed mode: the status period is h / rate)", rate_, 0.0, "");
     if (!recorder.empty()) throw InvalidInput("~recorder: recording is for lockstep mode; timed mode has none");
   }
+  publishClock_ = optionalParam(pnh, "publish_clock", false);
+  if (publishClock_ && timed_) {
+    throw InvalidInput("~publish_clock: lockstep only; timed agents run on ROS time, which a clock must not replace");
+  }
   monitor_ = std::make_unique<FormationMonitor>(loadScenario(path));
   const int n = monitor_->formation().agentCount();
   trails_.resize(static_cast<std::size_t>(n));
@@ -70,6 +75,7 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   statusPub_ = nh.advertise<FormationStatus>("status", 1000, true);
   markersPub_ = nh.advertise<visualization_msgs::MarkerArray>("markers", 1000, true);
   progressPub_ = nh.advertise<RunProgress>("progress", 10, true);
+  if (publishClock_) clockPub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
   for (int i = 0; i < n; ++i) {
     agents_.push_back({agentNodeName(nh, i), false, ros::WallTime(), ""});
     subs_.push_back(nh.subscribe<AgentState>(
@@ -195,6 +201,12 @@ void MonitorNode::publishCompleted() {
       status.angular_momentum_predicted.z = nan;
     }
     statusPub_.publish(status);
+    // Never backwards: with several formations on one master, the one furthest ahead sets it.
+    if (publishClock_ && (!ros::Time::isSimTime() || stamp >= ros::Time::now())) {
+      rosgraph_msgs::Clock clock;
+      clock.clock = stamp;
+      clockPub_.publish(clock);
+    }
     // Markers cost O(n x trail length) per step: built only when someone takes them (the
     // recorder, a viewer), every marker_every steps, and always at the first and last step so
     // that the latched one is right. The trails above still get every step.
@@ -453,8 +465,16 @@ void MonitorNode::recover() {
   for (std::size_t i = 0; i < agents_.size(); ++i) all.push_back(static_cast<int>(i));
   const std::vector<RecallHistory::Response> held = fetchHistories(all);
   std::vector<protocol::ProgressAnswer> answers;
-  for (const auto& h : held) answers.push_back({true, static_cast<bool>(h.has_progress), h.progress.completed_step, h.progress.converged_step});
+  for (const auto& h : held) {
+    const bool over = h.progress.state == RunProgress::FINISHED || h.progress.state == RunProgress::FAILED;
+    answers.push_back({true, static_cast<bool>(h.has_progress), h.progress.completed_step, h.progress.converged_step,
+                       over, h.progress.state == RunProgress::FINISHED});
+  }
   const protocol::MonitorResume r = protocol::chooseMonitorResume(answers, window_);
+  if (r.over) {  // it did not witness that run: neither its outcome nor a new run is its to report
+    finish(RunProgress::FAILED, protocol::describeOver(r));
+    return;
+  }
   if (!r.resumes()) return;  // a new run
   const long resumeAt = r.step, since = r.congruentSince;
   monitor_->startAt(resumeAt, since);

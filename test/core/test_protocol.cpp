@@ -79,6 +79,24 @@ TEST(Recovery, MonitorResumesAfterTheNewestProgressHeard) {
   EXPECT_FALSE(protocol::chooseMonitorResume({{true, false, 5, 1}, {true, true, -1, -1}}, 8).resumes());
 }
 
+TEST(Recovery, MonitorAgainstTheAgentsOfARunThatIsOverNeitherResumesNorStartsOne) {
+  // Agent 1 heard the final progress (finished at step 1500); agent 0 only an earlier one.
+  const auto r = protocol::chooseMonitorResume({{true, true, 1100, 40}, {true, true, 1500, 40, true, true}}, 8);
+  EXPECT_TRUE(r.over);
+  EXPECT_TRUE(r.finished);
+  EXPECT_EQ(r.overAt, 1500);
+  EXPECT_FALSE(r.resumes());
+  const std::string line = protocol::describeOver(r);
+  EXPECT_NE(line.find("already over (it finished at step 1500)"), std::string::npos) << line;
+  EXPECT_EQ(line.find('\n'), std::string::npos);
+  // A failed run is over too; an unanswered call says nothing.
+  const auto failed = protocol::chooseMonitorResume({{true, true, 30, -1, true, false}}, 8);
+  EXPECT_TRUE(failed.over);
+  EXPECT_NE(protocol::describeOver(failed).find("it failed at step 30"), std::string::npos);
+  EXPECT_FALSE(protocol::chooseMonitorResume({{false, true, 30, -1, true, true}, {true, true, 12, -1}}, 8).over);
+  EXPECT_EQ(protocol::describeOver(protocol::chooseMonitorResume({{true, true, 12, -1}}, 8)), "");
+}
+
 TEST(Recovery, WindowIsCheckedAgainstTheRecorderBuffers) {
   EXPECT_EQ(protocol::checkBuffers(100), "");
   const long largest = protocol::maxWindow(protocol::RecorderBuffers());

@@ -9,7 +9,8 @@ subprocesses, on the test's master), with real faults.
   the result file says failed, run_formation.sh exits non-zero.
 - Agents started first, each by its own agent.launch (as on robots), with stray subscribers on
   their topics, wait for the monitor and recorder started later (agents:=false): the bag is still
-  complete and equals simulate.
+  complete and equals simulate. A monitor started again against those agents, whose run is over,
+  says so in one line and reports a failure, not a success it did not witness.
 - agent.launch manager:=NAME: three agents loaded as nodelets into a manager started by hand,
   three as nodes, run with formation.launch agents:=false agent_manager:=NAME: equals simulate.
 - Flow control: while the monitor is stopped (SIGSTOP), no agent runs past the allowed step.
@@ -177,6 +178,19 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
             time.sleep(6.0)
             run = run_formation(f"scenario:={SCENARIO}", "agents:=false", "record:=true", f"output_dir:={out}")
             self.assertEqual(run.returncode, 0, run.stdout[-3000:] + run.stderr[-2000:])
+            # A monitor started again against these agents did not witness their run: it says in
+            # one line that the run is over, and reports no success.
+            again_dir = os.path.join(self.tmp, "again")
+            again = run_formation(f"scenario:={SCENARIO}", "agents:=false", f"output_dir:={again_dir}", timeout=90)
+            self.assertNotEqual(again.returncode, 0, again.stdout[-3000:])
+            over = [line for line in (again.stdout + again.stderr).splitlines()
+                    if "belong to a run that is already over (it finished at step" in line]
+            self.assertTrue(over, again.stdout[-3000:] + again.stderr[-2000:])
+            self.assertNotIn("run succeeded", again.stdout + again.stderr)
+            with open(os.path.join(again_dir, SCENARIO + ".result.yaml")) as f:
+                result = yaml.safe_load(f)
+            self.assertEqual(result["result"], "failed", result)
+            self.assertIn("already over", result["reason"])
             for a in agents:  # the run is over: the agents idle until they are stopped, as on robots
                 os.killpg(a.pid, signal.SIGINT)
                 log, _ = a.communicate(timeout=30)

@@ -34,6 +34,10 @@ using variational_formation::RunProgress;
  *
  * Topics, services and private parameters: doc/ros_api.md, "monitor".
  *
+ * Clock (~publish_clock, lockstep): it publishes /clock with the simulated time t_k of each
+ * completed step, unless that is behind the ROS time it already has (another formation's monitor
+ * ahead on the same master), so that with /use_sim_time tf lookups at now() and rviz follow the run.
+ *
  * Timed mode (~mode timed, ~real_time_factor > 0; doc/robots.md): the agents do not wait for each
  * other, so there are no completed steps to wait for. Once every agent's first state is there it
  * starts the run, then measures the newest state of every agent on a wall-clock timer of period
@@ -85,6 +89,9 @@ class MonitorNode {
   std::vector<ros::Subscriber> subs_;
   ros::Subscriber recorderSub_;
   ros::Publisher statusPub_, markersPub_, progressPub_;
+  /// ~publish_clock (lockstep): /clock follows the completed steps' simulated time, never backwards.
+  bool publishClock_ = false;
+  ros::Publisher clockPub_;
   ros::WallTimer watchTimer_;
   ros::ServiceServer recallServer_, historyServer_;
   /// Accepted states the recorder has not confirmed, per agent (at most a window each): an agent

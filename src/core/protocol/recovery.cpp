@@ -21,14 +21,30 @@ MonitorResume chooseMonitorResume(const std::vector<ProgressAnswer>& answers, lo
   MonitorResume r;
   r.step = -1;
   for (const ProgressAnswer& a : answers) {
+    if (a.answered && a.hasProgress && a.over && (!r.over || a.completedStep > r.overAt)) {
+      r.over = true;
+      r.finished = a.finished;
+      r.overAt = a.completedStep;
+    }
     if (a.answered && a.hasProgress && a.completedStep + 1 > r.step) {
       r.step = a.completedStep + 1;
       r.congruentSince = a.convergedStep;
     }
   }
+  if (r.over) {
+    r.step = 0;
+    return r;
+  }
   if (r.step <= 0) return MonitorResume();
   r.acceptUpTo = r.step + window + window / 4;
   return r;
+}
+
+std::string describeOver(const MonitorResume& r) {
+  if (!r.over) return "";
+  return std::string("the agents belong to a run that is already over (it ") + (r.finished ? "finished" : "failed") +
+         " at step " + std::to_string(r.overAt) +
+         "); this monitor did not witness it and starts no new run: start the agents again for a new run";
 }
 
 long recorderLead(long window) { return window + window / 4 + window / 4 + 1; }

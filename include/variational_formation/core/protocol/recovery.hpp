@@ -25,6 +25,8 @@ struct ProgressAnswer {
   bool hasProgress = false;  ///< the agent has heard a progress
   long completedStep = -1;   ///< that progress' completed step
   long convergedStep = -1;   ///< and its first step of the congruent stretch (-1 if none)
+  bool over = false;         ///< that progress ended the run (finished or failed)
+  bool finished = false;     ///< ... and it finished
 };
 
 /// Where a restarted lockstep monitor goes on.
@@ -34,10 +36,19 @@ struct MonitorResume {
   /// States past this step cannot come yet: the old monitor may have allowed its own completed
   /// step (at most a quarter window past what the agents heard) plus the window.
   long acceptUpTo = 0;
-  bool resumes() const { return step > 0; }
+  /// Some agent heard the final progress of its run: the run is over, and a monitor started
+  /// now did not witness it; it must neither resume nor report that run's outcome.
+  bool over = false;
+  bool finished = false;   ///< the run over finished (else it failed)
+  long overAt = -1;        ///< the completed step of that final progress
+  bool resumes() const { return !over && step > 0; }
 };
 
-/// The newest progress any agent heard decides; `window` is the monitor's ~window (>= 1).
+/// The one line a monitor started against the agents of a run that is over says (empty if not over).
+std::string describeOver(const MonitorResume& r);
+
+/// The newest progress any agent heard decides; `window` is the monitor's ~window (>= 1). If any
+/// agent heard a final progress (finished or failed), the agents' run is over (MonitorResume::over).
 MonitorResume chooseMonitorResume(const std::vector<ProgressAnswer>& answers, long window);
 
 /// The recorder's fixed buffers: its subscriber queues and how many steps of each agent it keeps

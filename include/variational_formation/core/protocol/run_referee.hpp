@@ -139,10 +139,15 @@ class LockstepReferee {
   /**
    * A restarted monitor: goes on from the newest progress the agents heard, with the states they
    * still hold. @param progress per agent, @param histories per agent (its unconfirmed states).
-   * @return false for a new run (nothing done).
+   * If the agents' run is already over, it fails saying so (describeOver): it did not witness it.
+   * @return false for a new run (nothing done) or a run already over (failed).
    */
   bool resume(const std::vector<ProgressAnswer>& progress, const std::vector<std::vector<State>>& histories) {
     const MonitorResume r = chooseMonitorResume(progress, window_);
+    if (r.over) {
+      fail(describeOver(r));
+      return false;
+    }
     if (!r.resumes()) return false;
     monitor_->startAt(r.step, r.congruentSince);
     progress_.state = Progress::State::Running;
