@@ -72,7 +72,8 @@ if(CATKIN_ENABLE_TESTING)
   add_rostest(test/ros/render.test)
   # SIGKILL to the nodelet manager of every agent during a recorded run: test/ros/nodelet_fault.test.
   add_rostest(test/ros/nodelet_fault.test ARGS seed:=3)
-  foreach(t two_formations two_teams launch)
+  # live_tf: tf lookups at now() during a default run (/clock, /use_sim_time).
+  foreach(t two_formations two_teams launch live_tf)
     add_rostest(test/ros/${t}.test)
   endforeach()
   # Agents on three network-namespace hosts sharing one master (needs root, as in CI). Not a

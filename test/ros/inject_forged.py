@@ -5,6 +5,7 @@ malformed ones (non-finite, wrong dimension, wrong id, impossible steps). Every 
 all of them, because they do not come from the node that owns agent_0. It publishes for
 ~duration seconds once the run moves, then sets ~published (how many it sent to subscribers)."""
 import math
+import time
 
 import rospy
 from variational_formation.msg import AgentState
@@ -23,11 +24,11 @@ def main():
     rospy.Subscriber(OWNER + "/state", AgentState, on_state)
     pub = rospy.Publisher(OWNER + "/state", AgentState, queue_size=100)
     while not rospy.is_shutdown() and latest["step"] < 1:
-        rospy.sleep(0.01)
+        time.sleep(0.01)
+    # Wall time: under /use_sim_time the run's clock races ahead, or stops when the run ends.
     published, k = 0, 0
-    end = rospy.get_time() + rospy.get_param("~duration", 3.0)
-    rate = rospy.Rate(50)
-    while not rospy.is_shutdown() and rospy.get_time() < end:
+    end = time.time() + rospy.get_param("~duration", 3.0)
+    while not rospy.is_shutdown() and time.time() < end:
         d, step = latest["d"], latest["step"] + 1
         cases = [
             dict(id=0, step=step, position=[0.5] * d, previous_position=[0.25] * d),  # well-formed
@@ -42,7 +43,7 @@ def main():
             pub.publish(msg)
             published += 1
         k += 1
-        rate.sleep()
+        time.sleep(0.02)
     rospy.set_param("~published", published)
     rospy.loginfo("inject_forged: published %d forged states of agent_0", published)
     rospy.spin()
