@@ -30,6 +30,7 @@ add_library(variational_formation_core
   src/core/manoeuvre.cpp
   src/core/manoeuvre_integrator.cpp
   src/core/tracking.cpp
+  src/core/run_outcome.cpp
   src/core/protocol/recovery.cpp
 )
 target_include_directories(variational_formation_core PUBLIC

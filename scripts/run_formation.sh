@@ -29,7 +29,12 @@ if [ ! -f "$result" ]; then
   [ "$status" -ne 0 ] && exit "$status" || exit 1
 fi
 outcome="$(sed -n 's/^result: //p' "$result")"
+formation="$(sed -n 's/^formation: //p' "$result" | tr -d '"')"
 case "$outcome" in
-  succeeded|stopped) exit 0 ;;
+  succeeded|stopped)
+    case "$formation" in
+      "not converged"*) echo "run_formation: the run $outcome, but the formation did not converge: ${formation#not converged }" >&2 ;;
+    esac
+    exit 0 ;;
   *) echo "run_formation: the run $outcome: $(sed -n 's/^reason: //p' "$result" | tr -d '"')" >&2; exit 1 ;;
 esac

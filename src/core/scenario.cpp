@@ -117,7 +117,9 @@ std::vector<ManoeuvreSegment> parseManoeuvre(const YAML::Node& list, int dimensi
 
 Scenario parseRoot(const YAML::Node& root) {
   if (!root.IsMap()) throw InvalidInput("scenario: expected a YAML mapping at the top level");
-  rejectUnknownKeys(root, {"name", "dimension", "kappa", "time_step", "steps", "agents", "edges", "manoeuvre"},
+  rejectUnknownKeys(root,
+                    {"name", "dimension", "kappa", "time_step", "steps", "agents", "edges", "manoeuvre",
+                     "require_convergence"},
                     "");
   Scenario s;
   const YAML::Node name = required(root, "name", "name");
@@ -133,6 +135,15 @@ Scenario parseRoot(const YAML::Node& root) {
   s.dampingGain = toFiniteDouble(required(root, "kappa", "kappa"), "kappa");
   s.timeStep = toFiniteDouble(required(root, "time_step", "time_step"), "time_step");
   s.steps = toInteger(required(root, "steps", "steps"), "steps");
+  if (root["require_convergence"].IsDefined() && !root["require_convergence"].IsNull()) {
+    const YAML::Node r = root["require_convergence"];
+    const std::string v = r.IsScalar() ? r.Scalar() : "";
+    if (v == "true") {
+      s.requireConvergence = true;
+    } else if (v != "false") {
+      throw InvalidInput("require_convergence: expected true or false, got " + describe(r));
+    }
+  }
 
   const YAML::Node agents = required(root, "agents", "agents");
   if (!agents.IsSequence() || agents.size() == 0) {

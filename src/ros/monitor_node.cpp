@@ -11,6 +11,7 @@
 
 #include "variational_formation/core/number_checks.hpp"
 #include "variational_formation/core/protocol/recovery.hpp"
+#include "variational_formation/core/run_outcome.hpp"
 #include "variational_formation/ros/markers.hpp"
 #include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/parameters.hpp"
@@ -220,6 +221,7 @@ void MonitorNode::publishCompleted() {
     }
     if (recording_) unrecorded_.push_back({status, markers});
     convergedStep_ = s.converged ? s.convergedStep : -1;
+    finalError_ = s.metrics.maxDistanceError;
     congruentSinceAt_[s.metrics.step] = convergedStep_;
     if (s.converged && reportedConvergence_ != s.convergedStep) {
       ROS_INFO("monitor: congruent with the desired shape since step %ld (t = %.3f s)", s.convergedStep,
@@ -355,25 +357,35 @@ void MonitorNode::writeResult(const std::string& result, const std::string& reas
   std::ofstream f(resultFile_);
   std::string quoted;
   for (char c : reason) quoted += c == '"' ? std::string("\\\"") : std::string(1, c);
+  const FormationOutcome formation = formationOutcome(convergedStep_, finalError_, monitor_->scenario().timeStep);
   f << "result: " << result << "\nscenario: " << monitor_->scenario().name
     << "\nsteps: " << monitor_->scenario().steps << "\ncompleted_step: " << completedStep()
-    << "\nconverged_step: " << convergedStep_ << "\ndropped: " << dropped_ << "\nreason: \"" << quoted << "\"\n";
+    << "\nconverged_step: " << convergedStep_ << "\nformation: \"" << formation.line
+    << "\"\nfinal_max_distance_error: " << finalError_ << "\ndropped: " << dropped_ << "\nreason: \"" << quoted
+    << "\"\n";
   if (!f) ROS_ERROR("monitor: cannot write the result file %s", resultFile_.c_str());
 }
 
-void MonitorNode::finish(uint8_t state, const std::string& reason) {
+void MonitorNode::finish(uint8_t state, std::string reason) {
   if (exitStatus_ >= 0) return;
   const long last = completedStep();
+  const double h = monitor_->scenario().timeStep;
+  const FormationOutcome formation = formationOutcome(convergedStep_, finalError_, h);
+  const RunVerdict verdict = finishedRunVerdict(monitor_->scenario(), formation);
   if (state == RunProgress::FINISHED) {
     const double seconds = (ros::WallTime::now() - firstStepAt_).toSec();
-    const double h = monitor_->scenario().timeStep;
-    writeResult("succeeded", "");
     ROS_INFO("monitor: %ld steps in %.3f s: %.0f steps/s, real-time factor %.1f at h = %g; %s; %ld dropped", last,
-             seconds, last / seconds, last * h / seconds, h,
-             reportedConvergence_ >= 0 ? ("converged at step " + std::to_string(reportedConvergence_)).c_str()
-                                       : "not converged",
-             dropped_);
-    ROS_INFO("monitor: run succeeded (%s)", resultFile_.empty() ? "no result file" : resultFile_.c_str());
+             seconds, last / seconds, last * h / seconds, h, formation.line.c_str(), dropped_);
+  }
+  if (state == RunProgress::FINISHED && !verdict.succeeded) {
+    state = RunProgress::FAILED;  // the scenario asked for a formation that did not form
+    reason = verdict.reason;
+  }
+  if (state == RunProgress::FINISHED) {
+    writeResult("succeeded", "");
+    // The last line says whether the formation formed: a run that never formed is no plain success.
+    ROS_INFO("monitor: run succeeded; formation %s (%s)", formation.line.c_str(),
+             resultFile_.empty() ? "no result file" : resultFile_.c_str());
     exitStatus_ = 0;
   } else {
     writeResult("failed", reason);

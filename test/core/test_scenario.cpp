@@ -10,6 +10,7 @@
 
 #include "test_support.hpp"
 #include "variational_formation/core/error.hpp"
+#include "variational_formation/core/run_outcome.hpp"
 #include "variational_formation/core/validation.hpp"
 #include "variational_formation/core/variational_update.hpp"
 
@@ -145,6 +146,36 @@ TEST(Scenario, UnknownFieldsAreRejected) {
   expectError(replaced(valid(), "steps: 10", "stpes: 10"), {"stpes: unknown field"});
   expectError(replaced(valid(), "id: 2,", "id: 2, colour: red,"), {"agents[2].colour: unknown field"});
 }
+TEST(Scenario, RequireConvergenceIsABoolean) {
+  EXPECT_FALSE(parseScenario(valid(), "file.yaml").requireConvergence);
+  EXPECT_TRUE(parseScenario(replaced(valid(), "steps: 10", "steps: 10\nrequire_convergence: true"), "f").requireConvergence);
+  EXPECT_FALSE(parseScenario(replaced(valid(), "steps: 10", "steps: 10\nrequire_convergence: false"), "f").requireConvergence);
+  expectError(replaced(valid(), "steps: 10", "steps: 10\nrequire_convergence: 1"), {"require_convergence: expected true or false"});
+  expectError(replaced(valid(), "steps: 10", "steps: 10\nrequire_convergence: [true]"), {"require_convergence: expected true or false"});
+}
+
+TEST(RunOutcome, SaysWhetherAndWhenTheFormationConverged) {
+  const FormationOutcome yes = formationOutcome(210, 1e-6, 0.014);
+  EXPECT_TRUE(yes.converged);
+  EXPECT_EQ(yes.line, "converged at step 210 (t = 2.940 s)");
+  const FormationOutcome no = formationOutcome(-1, 0.8125, 0.01);
+  EXPECT_FALSE(no.converged);
+  EXPECT_EQ(no.line, "not converged (final max distance error 0.812 m)");
+}
+
+TEST(RunOutcome, ANotConvergedRunFailsOnlyIfTheScenarioRequiresConvergence) {
+  Scenario s = parseScenario(valid(), "file.yaml");
+  const FormationOutcome no = formationOutcome(-1, 0.5, s.timeStep);
+  EXPECT_TRUE(finishedRunVerdict(s, no).succeeded);
+  EXPECT_TRUE(finishedRunVerdict(s, formationOutcome(3, 0.0, s.timeStep)).succeeded);
+  s.requireConvergence = true;
+  const RunVerdict v = finishedRunVerdict(s, no);
+  EXPECT_FALSE(v.succeeded);
+  EXPECT_EQ(v.reason, "the formation did not converge (final max distance error 0.5 m), and the scenario "
+                      "requires it (require_convergence: true)");
+  EXPECT_TRUE(finishedRunVerdict(s, formationOutcome(3, 0.0, s.timeStep)).succeeded);
+}
+
 TEST(Scenario, EmptyAgents) { expectError(kHeader + "agents: []\n", {"agents", "non-empty"}); }
 TEST(Scenario, NonRigidGraphIsAcceptedWithAWarning) {
   const Scenario s = parseScenario(replaced(valid(), ", [2, 0]]", "]"), "file.yaml");

@@ -3,6 +3,9 @@
 subprocesses, on the test's master), with real faults.
 
 - A recorded run through run_formation.sh succeeds (exit 0) and rviz renders its bag.
+- The result file and the monitor's last line say whether and when the formation converged; a run
+  that never formed says 'not converged' with its final error, and fails if its scenario requires
+  convergence.
 - Bad input (a missing scenario, kappa -1, a bad edge, a bad order or rate, an unwritable
   output_dir) ends the launch with one line naming the cause, and run_formation.sh exits non-zero.
 - Without respawn, an agent killed with SIGKILL, or with `rosnode kill`, ends the run: the monitor's line names it,
@@ -103,6 +106,38 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
         self.assertEqual(self.recording.returncode, 0, self.recording.stderr[-3000:])
         with open(os.path.join(self.tmp, SCENARIO + ".result.yaml")) as f:
             self.assertEqual(yaml.safe_load(f)["result"], "succeeded")
+
+    def test_result_says_whether_and_when_the_formation_converged(self):
+        """The recorded run converged and its result says at which step; a run too short to form
+        succeeds but says 'not converged' with the final error, in the result file and the monitor's
+        last line; the same run fails when its scenario has require_convergence: true."""
+        with open(os.path.join(self.tmp, SCENARIO + ".result.yaml")) as f:
+            done = yaml.safe_load(f)
+        self.assertEqual(done["result"], "succeeded")
+        self.assertRegex(done["formation"], r"^converged at step \d+ \(t = [0-9.]+ s\)$")
+        self.assertEqual(int(done["formation"].split()[3]), done["converged_step"])
+        for name, strict in (("short", False), ("short_strict", True)):
+            fields = dict(steps=20, require_convergence=True) if strict else dict(steps=20)
+            path = self.scenario_variant(name, **fields)
+            out = os.path.join(self.tmp, name)
+            run = run_formation(f"scenario:={path}", f"output_dir:={out}")
+            with open(os.path.join(out, name + ".result.yaml")) as f:
+                result = yaml.safe_load(f)
+            self.assertTrue(result["formation"].startswith("not converged (final max distance error "), result)
+            self.assertEqual(result["converged_step"], -1)
+            self.assertGreater(result["final_max_distance_error"], 0.0)
+            if strict:
+                self.assertNotEqual(run.returncode, 0, run.stdout[-3000:])
+                self.assertEqual(result["result"], "failed")
+                self.assertIn("the formation did not converge", result["reason"])
+                self.assertIn("requires it (require_convergence: true)", run.stderr)
+            else:
+                self.assertEqual(run.returncode, 0, run.stdout[-3000:] + run.stderr[-2000:])
+                self.assertEqual(result["result"], "succeeded")
+                last = [line for line in run.stdout.splitlines() if "monitor: run succeeded" in line]
+                self.assertTrue(last and "formation not converged (final max distance error" in last[-1],
+                                run.stdout[-3000:])
+                self.assertIn("the formation did not converge", run.stderr)
 
     def test_bad_input_is_one_line_and_a_failure(self):
         bad_edge = self.scenario_variant("bad_edge", edges=list(self.scenario["edges"]) + [[0, 9]])

@@ -29,6 +29,9 @@ struct Scenario {
   /// Initial heading [rad] of each agent's unicycle robot (field `initial_heading`, 2D only):
   /// empty if no agent gives one, else one per agent (0 where not given).
   std::vector<double> initialHeadings;
+  /// Field `require_convergence` (default false): a run whose formation is not congruent with
+  /// the desired shape at its end fails (doc/scenarios.md); otherwise it succeeds and says so.
+  bool requireConvergence = false;
   /// Non-fatal findings, one line each (a non-rigid desired graph, a too large h).
   std::vector<std::string> warnings;
 

@@ -76,7 +76,7 @@ class MonitorNode {
   void watch();
   bool checkAlive(Participant& p, const std::string& what, double timeout);
   std::string waitingFor() const;
-  void finish(uint8_t state, const std::string& reason);
+  void finish(uint8_t state, std::string reason);
   void writeResult(const std::string& result, const std::string& reason) const;
   // Timed mode.
   bool acceptTimed(int agent, const AgentState& msg, std::string& why);
@@ -119,6 +119,7 @@ class MonitorNode {
   long dropped_ = 0;
   long reportedConvergence_ = -2;
   long convergedStep_ = -1;
+  double finalError_ = 0.0;  // max distance error at the last completed step [m]
   ros::WallTime firstStepAt_, lastCompletedAt_, lastReportAt_, startedAt_;
   int exitStatus_ = -1;
   // Timed mode.

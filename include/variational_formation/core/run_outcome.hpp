@@ -1,0 +1,33 @@
+#pragma once
+
+#include <string>
+
+#include "variational_formation/core/scenario.hpp"
+
+namespace vf {
+
+/// Whether and when a run's formation became congruent with the desired shape, as the monitor's
+/// last line and the result file say it (doc/ros_api.md, "monitor").
+struct FormationOutcome {
+  bool converged = false;
+  double finalError = 0.0;  ///< max distance error at the last completed step [m]
+  /// "converged at step K (t = T s)" or "not converged (final max distance error E m)".
+  std::string line;
+};
+
+/**
+ * @param convergedStep first step of the congruent stretch that holds at the last completed step
+ * (-1: not congruent there); @param finalError the max distance error at that step [m];
+ * @param timeStep h [s].
+ */
+FormationOutcome formationOutcome(long convergedStep, double finalError, double timeStep);
+
+/// The verdict on a run that reached its last step: it succeeded, unless the scenario requires
+/// convergence (`require_convergence: true`) and the formation did not converge.
+struct RunVerdict {
+  bool succeeded = true;
+  std::string reason;  ///< why it failed (one line), empty if it succeeded
+};
+RunVerdict finishedRunVerdict(const Scenario& scenario, const FormationOutcome& formation);
+
+}  // namespace vf

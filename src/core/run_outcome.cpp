@@ -1,0 +1,35 @@
+#include "variational_formation/core/run_outcome.hpp"
+
+#include <cstdio>
+
+namespace vf {
+
+FormationOutcome formationOutcome(long convergedStep, double finalError, double timeStep) {
+  FormationOutcome o;
+  char text[160];
+  o.converged = convergedStep >= 0;
+  o.finalError = finalError;
+  if (o.converged) {
+    std::snprintf(text, sizeof text, "converged at step %ld (t = %.3f s)", convergedStep, convergedStep * timeStep);
+  } else {
+    std::snprintf(text, sizeof text, "not converged (final max distance error %.3g m)", finalError);
+  }
+  o.line = text;
+  return o;
+}
+
+RunVerdict finishedRunVerdict(const Scenario& scenario, const FormationOutcome& formation) {
+  RunVerdict v;
+  if (scenario.requireConvergence && !formation.converged) {
+    v.succeeded = false;
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "the formation did not converge (final max distance error %.3g m), and the scenario requires it "
+                  "(require_convergence: true)",
+                  formation.finalError);
+    v.reason = text;
+  }
+  return v;
+}
+
+}  // namespace vf
