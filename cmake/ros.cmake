@@ -5,6 +5,9 @@ add_library(variational_formation_ros src/ros/agent_node.cpp src/ros/markers.cpp
   src/ros/recorder_node.cpp)
 # The time-driven agent (doc/robots.md), selected by the agent's ~mode.
 target_sources(variational_formation_ros PRIVATE src/ros/timed_agent_node.cpp)
+# The monitor's two modes over its shared wiring, and the bounded pool of service calls.
+target_sources(variational_formation_ros PRIVATE src/ros/lockstep_monitor.cpp src/ros/timed_monitor.cpp
+  src/ros/service_call.cpp)
 add_dependencies(variational_formation_ros ${PROJECT_NAME}_gencfg)
 # catkin's include path is given to each ROS target privately (never exported: catkin_lint).
 target_include_directories(variational_formation_ros SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
@@ -67,6 +70,11 @@ if(CATKIN_ENABLE_TESTING)
     add_rostest(test/ros/timed_run.test ARGS ${args})
   endforeach()
   add_rostest(test/ros/timed_bad_input.test)
+  # The bounded pool of service calls (no master).
+  catkin_add_gtest(test_call_pool test/ros/test_call_pool.cpp)
+  target_include_directories(test_call_pool SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
+  target_link_libraries(test_call_pool variational_formation_ros gtest_main)
+  target_compile_options(test_call_pool PRIVATE ${VF_FLAGS})
   add_rostest(test/ros/robots_run.test)
   # render_bag.py on a recorded hexagon: video length, frames, processes left, bad inputs.
   add_rostest(test/ros/render.test)

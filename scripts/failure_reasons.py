@@ -19,11 +19,21 @@ def reasons(root, width):
             except (ElementTree.ParseError, OSError) as e:
                 yield f"{name}: unreadable ({e})"
                 continue
-            for case in tree.iter("testcase"):
-                for bad in list(case.iter("failure")) + list(case.iter("error")):
-                    text = " ".join((bad.get("message") or bad.text or "").split())
-                    text = text.split(' File "', 1)[0]  # the message, not the traceback
-                    yield f"{name}: {case.get('name')}: {text[:width]}"
+            for suite in tree.iter("testsuite"):
+                told = 0
+                for case in suite.iter("testcase"):
+                    for bad in list(case.iter("failure")) + list(case.iter("error")):
+                        told += 1
+                        text = " ".join((bad.get("message") or bad.text or "").split())
+                        text = text.split(' File "', 1)[0]  # the message, not the traceback
+                        yield f"{name}: {case.get('name')}: {text[:width]}"
+                # unittest counts an exception in setUpClass or a module fixture as an error of
+                # no test, and rosunit keeps only the count: show the end of the captured output.
+                untold = int(suite.get("errors") or 0) + int(suite.get("failures") or 0) - told
+                if untold > 0:
+                    err = " ".join(((suite.findtext("system-err") or "") + " " +
+                                    (suite.findtext("system-out") or "")).split())
+                    yield f"{name}: {untold} error(s) outside any test; the end of its output: {err[-width:]}"
 
 
 if __name__ == "__main__":

@@ -9,6 +9,16 @@ const char* const kUsage =
     "Private parameters: ~scenario (required), ~result_file, ~window, ~recorder, ~mode,\n"
     "~real_time_factor, ~wait_for_viewer, ~agent_manager, ~marker_every, ~respawn_timeout.\n"
     "Started by formation.launch; topics and services: doc/architecture.md.\n";
+
+/// The monitor of the mode its ~mode parameter names.
+class Monitor {
+ public:
+  Monitor(ros::NodeHandle& nh, ros::NodeHandle& pnh) : node_(vf::makeMonitor(nh, pnh)) {}
+  int run() { return node_->run(); }
+
+ private:
+  std::unique_ptr<vf::MonitorNode> node_;
+};
 }  // namespace
 
-int main(int argc, char** argv) { return vf::runNode<vf::MonitorNode>(argc, argv, "monitor", kUsage); }
+int main(int argc, char** argv) { return vf::runNode<Monitor>(argc, argv, "monitor", kUsage); }

@@ -24,6 +24,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import vf_rostest  # noqa: E402
 
 
+@vf_rostest.reported_setup
 class DistributedRun(unittest.TestCase, vf_rostest.RunChecks):
     @classmethod
     def setUpClass(cls):

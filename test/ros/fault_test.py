@@ -83,6 +83,7 @@ class Watch:
         return None
 
 
+@vf_rostest.reported_setup
 class FaultRun(unittest.TestCase, vf_rostest.RunChecks):
     @classmethod
     def setUpClass(cls):

@@ -80,6 +80,7 @@ class StepWatcher:
         return self.step >= step
 
 
+@vf_rostest.reported_setup
 class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
     @classmethod
     def setUpClass(cls):

@@ -292,6 +292,7 @@ def probe_main(args):
 
 # --- The tests -----------------------------------------------------------------------------------
 
+@vf_rostest.reported_setup
 class MultiHost(unittest.TestCase, vf_rostest.RunChecks):
     @classmethod
     def setUpClass(cls):

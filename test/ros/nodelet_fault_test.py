@@ -20,6 +20,7 @@ import vf_rostest  # noqa: E402
 from fault_test import NS, FaultRun, Watch  # noqa: E402
 
 
+@vf_rostest.reported_setup
 class ManagerFault(FaultRun):
     @classmethod
     def setUpClass(cls):

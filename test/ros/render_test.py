@@ -120,6 +120,7 @@ class Watched:
         return left
 
 
+@vf_rostest.reported_setup
 class RenderTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):

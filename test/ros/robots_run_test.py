@@ -24,6 +24,7 @@ import vf_rostest  # noqa: E402
 TOLERANCE = 0.01  # [m] on every edge length, from the robots' averaged odometry
 
 
+@vf_rostest.reported_setup
 class RobotsRun(unittest.TestCase):
     @classmethod
     def setUpClass(cls):

@@ -25,6 +25,7 @@ def run(command):
     return p.returncode, [line for line in p.stderr.splitlines() if line.strip()]
 
 
+@vf_rostest.reported_setup
 class TimedBadInput(unittest.TestCase):
     @classmethod
     def setUpClass(cls):

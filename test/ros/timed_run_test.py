@@ -49,6 +49,7 @@ def node_pid(name, old=None, timeout=20.0):
     raise AssertionError(f"{name} did not come up")
 
 
+@vf_rostest.reported_setup
 class TimedRun(unittest.TestCase):
     @classmethod
     def setUpClass(cls):

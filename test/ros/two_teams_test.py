@@ -47,6 +47,7 @@ def result(path):
     return vf_rostest.wait_for_result(path, 0.0).get("result")
 
 
+@vf_rostest.reported_setup
 class TwoTeams(unittest.TestCase, vf_rostest.RunChecks):
     @classmethod
     def setUpClass(cls):

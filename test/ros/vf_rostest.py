@@ -7,6 +7,7 @@ import os
 import subprocess
 import tempfile
 import time
+import traceback
 
 import xmlrpc.client
 
@@ -16,6 +17,42 @@ import rospkg
 import yaml
 
 PKG = "variational_formation"
+
+
+def reported_setup(cls):
+    """Class decorator for a rostest's TestCase: an exception in setUpClass fails every test with
+    its message and the line it came from. Left alone, unittest counts it as an error outside
+    any test, and rosunit's XML keeps neither the message nor the traceback."""
+    set_up_class = cls.__dict__["setUpClass"].__func__
+    tear_down_class = cls.__dict__["tearDownClass"].__func__ if "tearDownClass" in cls.__dict__ else None
+    set_up = cls.setUp
+
+    def guarded_set_up_class(klass):
+        klass.setup_error = None
+        try:
+            set_up_class(klass)
+        except Exception as e:  # reported by every test below
+            frame = traceback.extract_tb(e.__traceback__)[-1]
+            klass.setup_error = (f"setUpClass failed at {os.path.basename(frame.filename)}:{frame.lineno}: "
+                                 f"{type(e).__name__}: {e}")
+
+    def guarded_tear_down_class(klass):
+        try:
+            tear_down_class(klass)
+        except Exception:
+            if klass.setup_error is None:
+                raise  # after a failed setUpClass, attributes it never set are no news
+
+    def checked_set_up(self):
+        if type(self).setup_error:
+            self.fail(type(self).setup_error)
+        set_up(self)
+
+    cls.setUpClass = classmethod(guarded_set_up_class)
+    if tear_down_class:
+        cls.tearDownClass = classmethod(guarded_tear_down_class)
+    cls.setUp = checked_set_up
+    return cls
 
 
 def scenario_path(name):

@@ -1,9 +1,9 @@
 #pragma once
 
 #include <deque>
-#include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <ros/ros.h>
@@ -15,6 +15,9 @@
 #include "variational_formation/RecallState.h"
 #include "variational_formation/RunProgress.h"
 #include "variational_formation/core/monitor.hpp"
+#include "variational_formation/core/protocol/run_referee.hpp"
+#include "variational_formation/core/protocol/timed_referee.hpp"
+#include "variational_formation/ros/service_call.hpp"
 
 namespace vf {
 
@@ -25,110 +28,155 @@ using variational_formation::RecallState;
 using variational_formation::RunProgress;
 
 /**
- * The referee of a run (doc/distributed.md): collects every agent's states (only from the node
- * that owns each agent), publishes `status` and `markers` for each completed step, and the
- * latched `progress` that starts the agents once every participant is there and holds them at
- * most ~window steps ahead of what it and the recorder have completed. It says every few
- * seconds what a stalled run waits for, ends the run as failed when a participant dies, and
- * writes the outcome to ~result_file. Maths: FormationMonitor.
- *
- * Topics, services and private parameters: doc/ros_api.md, "monitor".
- *
- * Clock (~publish_clock, lockstep): it publishes /clock with the simulated time t_k of each
- * completed step, unless that is behind the ROS time it already has (another formation's monitor
- * ahead on the same master), so that with /use_sim_time tf lookups at now() and rviz follow the run.
- *
- * Timed mode (~mode timed, ~real_time_factor > 0; doc/robots.md): the agents do not wait for each
- * other, so there are no completed steps to wait for. Once every agent's first state is there it
- * starts the run, then measures the newest state of every agent on a wall-clock timer of period
- * h / rate (its own step count is the timer's) and reports the age of the oldest data it used
- * (`max_data_age`). The run ends after the scenario's steps of that timer, or when every agent
- * has reached them. The Noether predictions do not hold there: they are published as NaN.
- *
- * Recovery: it serves `~recall` (each agent's newest state, for a restarted agent), and when it
- * starts in the middle of a run it rebuilds the steps it had not completed from the agents'
- * `~history` and goes on from there.
+ * The monitor's wiring that both modes share (doc/distributed.md, doc/ros_api.md "monitor"): the
+ * common parameters, the `status`, `markers` and latched `progress` publishers, /clock, the
+ * participants and whether they are alive, the result file and the end of the run. What a state
+ * means, when the run starts, flows and ends is the mode's referee (core/protocol):
+ * LockstepMonitor or TimedMonitor. Built by makeMonitor from ~mode.
  */
 class MonitorNode {
  public:
-  /// @throws InvalidInput on a missing or bad parameter or scenario.
-  MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  virtual ~MonitorNode() = default;
   /// Until the run ends (or shutdown). @return the exit status: 0 finished, 1 failed.
   int run();
 
- private:
+ protected:
   struct Participant {
-    std::string node;            // full node name
-    bool seen = false;           // has sent a valid message
-    ros::WallTime goneSince;     // zero while alive
-    std::string host;            // the node its messages came from: itself, or its nodelet manager
+    std::string node;         // full node name
+    bool seen = false;        // has sent a valid message
+    ros::WallTime goneSince;  // zero while alive
+    std::string host;         // the node its messages came from: itself, or its nodelet manager
   };
-  void recover();
-  std::vector<RecallHistory::Response> fetchHistories(const std::vector<int>& agents);
-  void addHistory(int agent, const RecallHistory::Response& held);
-  void catchUpFromNeighbours(const std::vector<int>& agents);
-  bool onRecall(RecallState::Request& request, RecallState::Response& response);
-  bool onHistory(RecallHistory::Request& request, RecallHistory::Response& response);
-  void onState(int agent, const ros::MessageEvent<AgentState const>& event);
-  void onRecorderProgress(const ros::MessageEvent<RunProgress const>& event);
-  void publishCompleted();
-  void updateProgress();
-  void watch();
+  using Published = std::pair<FormationStatus, visualization_msgs::MarkerArray>;
+
+  /// Reads and checks the common parameters and the scenario (@throws InvalidInput), opens the
+  /// result file, advertises and subscribes every agent's state (delivered from run() on).
+  /// `timed` selects which of ~recorder and ~publish_clock apply.
+  MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh, bool timed);
+  /// The line every monitor starts with.
+  void announce(const std::string& recorder) const;
+
+  // What the mode decides.
+  virtual void onState(int agent, const ros::MessageEvent<AgentState const>& event) = 0;
+  virtual void begin() = 0;  ///< before spinning (a restarted lockstep monitor recovers here)
+  virtual void watch() = 0;  ///< every 0.5 s
+  virtual std::string waitingFor() const = 0;
+  virtual long completedStep() const = 0;
+  virtual const FormationMonitor& measure() const = 0;
+
+  /// Publishes one completed step's status and markers (and /clock), stamped `stamp`; tracks the
+  /// congruent stretch for the result. @return what was published, for the recorder gate.
+  Published publishSnapshot(const FormationSnapshot& s, const ros::Time& stamp, double dataAge, bool noetherHolds);
+  /// Publishes `progress` (its header stamped with the completed step's simulated time).
+  void publishProgress(const RunProgress& progress);
+  /// True if `event` came from the node that owns agent `agent` (or its manager), with its id and
+  /// no failure; otherwise counts a drop or ends the run on the agent's failure.
+  bool fromItsAgent(int agent, const ros::MessageEvent<AgentState const>& event);
+  /// Agent `agent` was heard (from the node or manager that published `event`).
+  void heard(int agent, const ros::MessageEvent<AgentState const>& event);
+  void drop(int agent, const std::string& why);
   bool checkAlive(Participant& p, const std::string& what, double timeout);
-  std::string waitingFor() const;
+  void reportWaiting(const std::string& line);
+  /// Ends the run once (finished may turn into failed when the scenario requires convergence).
   void finish(uint8_t state, std::string reason);
-  void writeResult(const std::string& result, const std::string& reason) const;
-  // Timed mode.
-  bool acceptTimed(int agent, const AgentState& msg, std::string& why);
-  void tickTimed();
-  void watchTimed();
-  long completedStep() const { return monitor_->nextStep() - 1; }
+  bool ended() const { return exitStatus_ >= 0; }
+  static std::string agentList(const std::vector<int>& ids) {
+    return protocol::LockstepReferee<AgentState, Published>::agentList(ids);
+  }
 
   ros::NodeHandle nh_;
-  std::unique_ptr<FormationMonitor> monitor_;
-  std::vector<ros::Subscriber> subs_;
-  ros::Subscriber recorderSub_;
-  ros::Publisher statusPub_, markersPub_, progressPub_;
-  /// ~publish_clock (lockstep): /clock follows the completed steps' simulated time, never backwards.
-  bool publishClock_ = false;
-  ros::Publisher clockPub_;
-  ros::WallTimer watchTimer_;
-  ros::ServiceServer recallServer_, historyServer_;
-  /// Accepted states the recorder has not confirmed, per agent (at most a window each): an agent
-  /// that dies again before the recorder got them no longer holds them.
-  std::vector<std::deque<AgentState>> unrecordedStates_;
-  std::vector<AgentState> newest_;          // each agent's newest state, for ~recall
-  std::map<long, long> congruentSinceAt_;   // completed step -> first step of its congruent stretch
-  std::vector<Participant> agents_;
-  std::vector<std::string> managers_;  // ~agent_manager: nodelet managers of agents
-  Participant recorder_;
-  bool recording_ = false;
-  long recordedStep_ = -1;
-  bool recorderDone_ = false;
-  std::vector<std::deque<Eigen::Vector3d>> trails_;
-  int trailLength_ = 100;
-  long markerEvery_ = 1;  // ~marker_every: markers of every k-th step (and the first and last)
+  std::string path_;
+  Scenario scenario_;
+  std::string recorderParam_;  // ~recorder, relative
+  bool recording_ = false;     // a recorder takes part (lockstep)
   long window_ = 100;
   bool waitForViewer_ = false;
   double respawnTimeout_ = 0.0;
-  std::string resultFile_;
+  std::vector<std::string> managers_;  // ~agent_manager: nodelet managers of agents
+  std::vector<Participant> agents_;
+  ros::Publisher statusPub_, markersPub_, progressPub_;
   RunProgress progress_;
-  long acceptUpTo_ = 0;
-  /// Published status and markers the recorder has not confirmed (at most a window of them).
-  std::deque<std::pair<FormationStatus, visualization_msgs::MarkerArray>> unrecorded_;  // states past this step cannot come yet (bounds the buffer)
   long dropped_ = 0;
-  long reportedConvergence_ = -2;
-  long convergedStep_ = -1;
-  double finalError_ = 0.0;  // max distance error at the last completed step [m]
   ros::WallTime firstStepAt_, lastCompletedAt_, lastReportAt_, startedAt_;
+  long reportedConvergence_ = -2;  // the congruent stretch already announced (-2: none)
+  long convergedStep_ = -1;        // first step of the congruent stretch at the newest step (-1: none)
+
+ private:
+  void writeResult(const std::string& result, const std::string& reason) const;
+
+  std::vector<ros::Subscriber> subs_;
+  ros::Publisher clockPub_;
+  bool publishClock_ = false;  // ~publish_clock (lockstep): /clock follows the completed steps, never backwards
+  ros::WallTimer watchTimer_;
+  std::vector<std::deque<Eigen::Vector3d>> trails_;
+  int trailLength_ = 100;
+  long markerEvery_ = 1;
+  std::string resultFile_;
+  double finalError_ = 0.0;  // max distance error at the last completed step [m]
   int exitStatus_ = -1;
-  // Timed mode.
-  bool timed_ = false;
-  double rate_ = 0.0;
-  std::vector<double> receivedAt_;  // wall time [s] of each agent's newest state
-  ros::WallTimer tickTimer_;
-  long tick_ = -1;
-  double dataAge_ = 0.0;            // of the oldest state used by the newest status [s]
 };
+
+/**
+ * Lockstep mode: the referee of an exact run (protocol::LockstepReferee). Collects every agent's
+ * states, publishes each completed step, starts the agents by identity and holds them at most
+ * ~window steps ahead of what it and the recorder completed; catches up missing states from the
+ * agents' histories and their neighbours'; serves `~recall` and `~history`; a restarted monitor
+ * rebuilds the steps it had not completed from the agents' histories and goes on.
+ */
+class LockstepMonitor : public MonitorNode {
+ public:
+  LockstepMonitor(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+
+ private:
+  using Referee = protocol::LockstepReferee<AgentState, Published>;
+  void onState(int agent, const ros::MessageEvent<AgentState const>& event) override;
+  void begin() override;
+  void watch() override;
+  std::string waitingFor() const override { return referee_->waitingFor(recorder_.node); }
+  long completedStep() const override { return referee_->completedStep(); }
+  const FormationMonitor& measure() const override { return referee_->monitor(); }
+  void onRecorderProgress(const ros::MessageEvent<RunProgress const>& event);
+  bool onRecall(RecallState::Request& request, RecallState::Response& response);
+  bool onHistory(RecallHistory::Request& request, RecallHistory::Response& response);
+  /// Each completed step, then the progress.
+  void publishCompleted();
+  void updateProgress();
+  /// The states agents `ids` hold of themselves (`~history`), in order of `ids`.
+  std::vector<RecallHistory::Response> fetchHistories(const std::vector<int>& ids);
+  void catchUpFromNeighbours(const std::vector<int>& ids);
+
+  std::unique_ptr<Referee> referee_;
+  Participant recorder_;
+  ros::Subscriber recorderSub_;
+  ros::ServiceServer recallServer_, historyServer_;
+};
+
+/**
+ * Timed mode (doc/robots.md): the agents do not wait for each other. Once every agent's first
+ * state is there it starts the run, then measures the newest state of every agent on a
+ * wall-clock timer of period h / rate (protocol::TimedReferee) and reports the age of the oldest
+ * data it used. The run ends after the scenario's steps of that timer, or when every agent has
+ * reached them. The Noether predictions do not hold there: they are published as NaN.
+ */
+class TimedMonitor : public MonitorNode {
+ public:
+  TimedMonitor(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+
+ private:
+  void onState(int agent, const ros::MessageEvent<AgentState const>& event) override;
+  void begin() override;
+  void watch() override;
+  std::string waitingFor() const override;
+  long completedStep() const override { return referee_->completedStep(); }
+  const FormationMonitor& measure() const override { return referee_->monitor(); }
+  void tick();
+
+  std::unique_ptr<protocol::TimedReferee<AgentState>> referee_;
+  double rate_ = 0.0;
+  ros::WallTimer tickTimer_;
+};
+
+/// The monitor of ~mode (lockstep or timed). @throws InvalidInput on a bad parameter or scenario.
+std::unique_ptr<MonitorNode> makeMonitor(ros::NodeHandle& nh, ros::NodeHandle& pnh);
 
 }  // namespace vf

@@ -144,6 +144,7 @@ class LockstepReferee {
    */
   bool resume(const std::vector<ProgressAnswer>& progress, const std::vector<std::vector<State>>& histories) {
     const MonitorResume r = chooseMonitorResume(progress, window_);
+    resumedFrom_ = r;
     if (r.over) {
       fail(describeOver(r));
       return false;
@@ -194,6 +195,8 @@ class LockstepReferee {
     return s;
   }
 
+  /// The choice resume() made (where it went on, the congruent stretch, or why not).
+  const MonitorResume& resumedFrom() const { return resumedFrom_; }
   const Progress& progressNow() const { return progress_; }
   bool ended() const { return progress_.state == Progress::State::Finished || progress_.state == Progress::State::Failed; }
   bool running() const { return progress_.state == Progress::State::Running; }
@@ -216,6 +219,7 @@ class LockstepReferee {
   long window_;
   bool recording_, waitForViewer_;
   Progress progress_;
+  MonitorResume resumedFrom_;
   bool started_ = false;
   long acceptUpTo_ = 0;
   long recordedStep_ = -1;
