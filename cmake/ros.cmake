@@ -7,7 +7,7 @@ add_library(variational_formation_ros src/ros/agent_node.cpp src/ros/markers.cpp
 target_sources(variational_formation_ros PRIVATE src/ros/timed_agent_node.cpp)
 # The monitor's two modes over its shared wiring, and the bounded pool of service calls.
 target_sources(variational_formation_ros PRIVATE src/ros/lockstep_monitor.cpp src/ros/timed_monitor.cpp
-  src/ros/service_call.cpp)
+  src/ros/service_call.cpp src/ros/state_batch.cpp)
 add_dependencies(variational_formation_ros ${PROJECT_NAME}_gencfg)
 # catkin's include path is given to each ROS target privately (never exported: catkin_lint).
 target_include_directories(variational_formation_ros SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
@@ -43,7 +43,7 @@ if(CATKIN_ENABLE_TESTING)
     "scenario:=free_particle expect:=free_particle"
     "scenario:=hexagon order:=reverse stagger:=1"
     "scenario:=hexagon rate:=1 inject:=true"
-    "scenario:=hexagon nodelet:=true"
+    "scenario:=hexagon nodelet:=true inject:=true rate:=1"
     "scenario:=grid24 nodelet:=true"
     # Scale: a 3D lattice of 48 agents written by make_scenario, all in one manager.
     "scenario:=lattice48 nodelet:=true")
@@ -99,3 +99,11 @@ target_link_libraries(robot_sim variational_formation_core ${catkin_LIBRARIES})
 target_compile_options(robot_sim PRIVATE ${VF_FLAGS})
 add_dependencies(robot_sim ${catkin_EXPORTED_TARGETS})
 install(TARGETS robot_sim RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+
+# The transport's ceiling for a nodelet run (benchmark/transport_ceiling.sh), built for the
+# checkout only, like benchmark_roa.
+add_executable(benchmark_transport benchmark/benchmark_transport.cpp)
+add_dependencies(benchmark_transport ${PROJECT_NAME}_generate_messages_cpp)
+target_include_directories(benchmark_transport SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
+target_link_libraries(benchmark_transport ${catkin_LIBRARIES})
+target_compile_options(benchmark_transport PRIVATE ${VF_FLAGS})

@@ -8,8 +8,6 @@
 // ~scenario, ~real_time_factor, ~monitor, ~agent_manager passed on to every agent (AgentNode
 // checks them); nodelet itself reads ~num_worker_threads.
 #include <cmath>
-#include <set>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -19,28 +17,9 @@
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/ros/node_main.hpp"
 #include "variational_formation/ros/parameters.hpp"
+#include "variational_formation/ros/state_batch.hpp"
 
 namespace {
-
-std::vector<int> agentIds(const std::string& list) {
-  std::istringstream words(list);
-  std::vector<int> ids;
-  std::set<int> seen;
-  for (std::string w; words >> w;) {
-    std::size_t used = 0;
-    int id = -1;
-    try {
-      id = std::stoi(w, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != w.size() || id < 0) throw vf::InvalidInput("~agents: '" + w + "' is not an agent id (an integer >= 0)");
-    if (!seen.insert(id).second) throw vf::InvalidInput("~agents: agent " + w + " is listed twice");
-    ids.push_back(id);
-  }
-  if (ids.empty()) throw vf::InvalidInput("~agents: no agent ids in '" + list + "'");
-  return ids;
-}
 
 /// ~agents as text: a list in a string ("0 1 2"), or one id.
 std::string agentList(const ros::NodeHandle& pnh) {
@@ -83,9 +62,14 @@ int main(int argc, char** argv) {
   ros::NodeHandle nh, pnh("~");
   const std::string me = ros::this_node::getName();
   try {
-    const std::vector<int> ids = agentIds(agentList(pnh));
+    const std::vector<int> ids = vf::parseAgentIds(agentList(pnh), "~agents");
     const double stagger = vf::optionalParam(pnh, "stagger", 0.0);
     if (!(stagger >= 0.0 && std::isfinite(stagger))) throw vf::InvalidInput("~stagger: must be >= 0 seconds");
+    // One message per step with all of its agents' states, for the monitor and the recorder.
+    vf::StateBatch::start(pnh, ids);
+    struct StopBatch {
+      ~StopBatch() { vf::StateBatch::stop(); }  // after the loader (declared below) unloaded the agents
+    } stopBatch;
     nodelet::Loader loader(pnh);  // the load_nodelet, unload_nodelet and list services, on the global queue
     ros::AsyncSpinner spinner(1);
     spinner.start();
@@ -97,7 +81,8 @@ int main(int argc, char** argv) {
       // missing plugin, in an ERROR line): exit without a second line.
       if (!loader.load(name, "variational_formation/Agent", ros::M_string(), std::vector<std::string>())) return 2;
     }
-    ROS_INFO("%s: %zu agents loaded", me.c_str(), ids.size());
+    ROS_INFO("%s: %zu agents loaded; their states also go out batched on %s/states", me.c_str(), ids.size(),
+             me.c_str());
     ros::waitForShutdown();
   } catch (const std::exception& e) {
     ROS_FATAL("%s: %s", me.c_str(), e.what());

@@ -7,6 +7,7 @@
 #include "variational_formation/core/validation.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/state_batch.hpp"
 
 namespace vf {
 
@@ -150,6 +151,7 @@ void AgentNode::publish() {
   const AgentState::ConstPtr published = state;
   statePub_.publish(published);
   history_.push_back(published);
+  if (StateBatch* batch = StateBatch::local()) batch->add(published);  // in an agent_manager
 
   tf_.sendTransform(frameAt(msg.header, frame_, msg.position));
 }

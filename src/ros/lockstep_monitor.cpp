@@ -48,22 +48,20 @@ LockstepMonitor::LockstepMonitor(ros::NodeHandle& nh, ros::NodeHandle& pnh) : Mo
   announce(recorder_.node);
 }
 
-void LockstepMonitor::onState(int agent, const ros::MessageEvent<AgentState const>& event) {
-  if (!fromItsAgent(agent, event)) return;
-  const AgentState& msg = *event.getConstMessage();
+bool LockstepMonitor::offer(int agent, const AgentState& msg, const std::string& publisher) {
   std::string why;
   try {
     const auto receipt = referee_->offerState(agent, msg);
     if (receipt == FormationMonitor::Receipt::Accepted || receipt == FormationMonitor::Receipt::Duplicate) {
-      heard(agent, event);
-      if (receipt == FormationMonitor::Receipt::Accepted) publishCompleted();
-      return;
+      heard(agent, publisher);
+      return receipt == FormationMonitor::Receipt::Accepted;
     }
     why = "(step " + std::to_string(msg.step) + "): " + FormationMonitor::describe(receipt);
   } catch (const std::exception& e) {
     why = e.what();
   }
   drop(agent, why);
+  return false;
 }
 
 void LockstepMonitor::onRecorderProgress(const ros::MessageEvent<RunProgress const>& event) {

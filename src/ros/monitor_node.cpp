@@ -53,12 +53,24 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh, bool timed) 
   markersPub_ = nh.advertise<visualization_msgs::MarkerArray>("markers", 1000, true);
   progressPub_ = nh.advertise<RunProgress>("progress", 10, true);
   if (publishClock_) clockPub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  // A manager's agents come in its batches (one message per step), the others on their own topics.
+  batches_ = batchSources(nh, managers_, n);
+  std::vector<bool> batched(static_cast<std::size_t>(n), false);
+  for (std::size_t m = 0; m < batches_.size(); ++m) {
+    for (int id : batches_[m].ids) batched[static_cast<std::size_t>(id)] = true;
+    subs_.push_back(nh.subscribe<variational_formation::AgentStates>(
+        batches_[m].manager + "/states", static_cast<uint32_t>(2 * window_ + 10),
+        boost::function<void(const ros::MessageEvent<variational_formation::AgentStates const>&)>(
+            [this, m](const ros::MessageEvent<variational_formation::AgentStates const>& e) { onBatch(m, e); }),
+        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
+  }
   for (int i = 0; i < n; ++i) {
     agents_.push_back({agentNodeName(nh, i), false, ros::WallTime(), ""});
+    if (batched[static_cast<std::size_t>(i)]) continue;
     subs_.push_back(nh.subscribe<AgentState>(
         "agent_" + std::to_string(i) + "/state", static_cast<uint32_t>(2 * window_ + 10),
         boost::function<void(const ros::MessageEvent<AgentState const>&)>(
-            [this, i](const ros::MessageEvent<AgentState const>& e) { onState(i, e); }),
+            [this, i](const ros::MessageEvent<AgentState const>& e) { onAgentTopic(i, e); }),
         ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
   }
   progress_.state = RunProgress::WAITING;
@@ -74,25 +86,51 @@ void MonitorNode::announce(const std::string& recorder) const {
            waitForViewer_ ? ", waits for a viewer" : "");
 }
 
-bool MonitorNode::fromItsAgent(int agent, const ros::MessageEvent<AgentState const>& event) {
+void MonitorNode::onAgentTopic(int agent, const ros::MessageEvent<AgentState const>& event) {
   const AgentState& msg = *event.getConstMessage();
-  const Participant& owner = agents_[static_cast<std::size_t>(agent)];
-  if (!fromAgent(event, owner.node, managers_)) {
+  if (!fromAgent(event, agents_[static_cast<std::size_t>(agent)].node, managers_)) {
     drop(agent, "from " + event.getPublisherName() + ", which does not own it");
   } else if (static_cast<int>(msg.id) != agent) {
     drop(agent, "with id " + std::to_string(msg.id));
-  } else if (!msg.failure.empty()) {
-    finish(RunProgress::FAILED, owner.node + ": " + msg.failure);
-  } else {
-    return true;
+  } else if (admit(agent, msg, event.getPublisherName())) {
+    afterAccepted();
   }
-  return false;
 }
 
-void MonitorNode::heard(int agent, const ros::MessageEvent<AgentState const>& event) {
+void MonitorNode::onBatch(std::size_t source, const ros::MessageEvent<variational_formation::AgentStates const>& event) {
+  const BatchSource& from = batches_[source];
+  if (!fromOwner(event, from.manager)) {
+    ++dropped_;
+    ROS_WARN_THROTTLE(1.0, "monitor: dropped a batch of states on %s/states from %s, which is not that manager",
+                      from.manager.c_str(), event.getPublisherName().c_str());
+    return;
+  }
+  bool accepted = false;
+  for (const AgentState& msg : event.getConstMessage()->states) {
+    if (from.ids.count(static_cast<int>(msg.id)) == 0) {
+      ++dropped_;
+      ROS_WARN_THROTTLE(1.0, "monitor: dropped a state of agent %u in a batch of %s, which does not hold that agent",
+                        msg.id, from.manager.c_str());
+      continue;
+    }
+    accepted = admit(static_cast<int>(msg.id), msg, event.getPublisherName()) || accepted;
+    if (ended()) return;
+  }
+  if (accepted) afterAccepted();
+}
+
+bool MonitorNode::admit(int agent, const AgentState& msg, const std::string& publisher) {
+  if (!msg.failure.empty()) {
+    finish(RunProgress::FAILED, agents_[static_cast<std::size_t>(agent)].node + ": " + msg.failure);
+    return false;
+  }
+  return offer(agent, msg, publisher);
+}
+
+void MonitorNode::heard(int agent, const std::string& publisher) {
   Participant& owner = agents_[static_cast<std::size_t>(agent)];
   owner.seen = true;
-  owner.host = event.getPublisherName();
+  owner.host = publisher;
   owner.goneSince = ros::WallTime();
 }
 

@@ -48,10 +48,22 @@ RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh),
   const std::string prefix = framePrefix(nh);
   statusTopic_ = nh.resolveName("status");
   markersTopic_ = nh.resolveName("markers");
+  // A manager's agents come in its batches (one message per step), the others on their own topics.
+  batches_ = batchSources(nh, managers_, n);
+  std::vector<bool> batched(static_cast<std::size_t>(n), false);
+  for (std::size_t m = 0; m < batches_.size(); ++m) {
+    for (int id : batches_[m].ids) batched[static_cast<std::size_t>(id)] = true;
+    subs_.push_back(nh.subscribe<variational_formation::AgentStates>(
+        batches_[m].manager + "/states", kQueue,
+        boost::function<void(const ros::MessageEvent<variational_formation::AgentStates const>&)>(
+            [this, m](const ros::MessageEvent<variational_formation::AgentStates const>& e) { onBatch(m, e); }),
+        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
+  }
   for (int i = 0; i < n; ++i) {
     owners_.push_back(agentNodeName(nh, i));
     stateTopics_.push_back(nh.resolveName("agent_" + std::to_string(i) + "/state"));
     frameIds_.push_back(prefix + "agent_" + std::to_string(i));
+    if (batched[static_cast<std::size_t>(i)]) continue;
     subs_.push_back(nh.subscribe<AgentState>(
         "agent_" + std::to_string(i) + "/state", kQueue,
         boost::function<void(const ros::MessageEvent<AgentState const>&)>(
@@ -135,6 +147,20 @@ void RecorderNode::onState(int agent, const ros::MessageEvent<AgentState const>&
     return;
   }
   record(agent, msg);
+}
+
+void RecorderNode::onBatch(std::size_t source, const ros::MessageEvent<variational_formation::AgentStates const>& event) {
+  const BatchSource& from = batches_[source];
+  const bool owner = fromOwner(event, from.manager);
+  for (const AgentState& msg : event.getConstMessage()->states) {
+    if (!owner || from.ids.count(static_cast<int>(msg.id)) == 0) {
+      ++dropped_;
+      ROS_WARN_THROTTLE(1.0, "recorder: dropped a state of agent %u in a batch on %s/states from %s; %ld dropped so far",
+                        msg.id, from.manager.c_str(), event.getPublisherName().c_str(), dropped_);
+      continue;
+    }
+    record(static_cast<int>(msg.id), boost::make_shared<const AgentState>(msg));
+  }
 }
 
 void RecorderNode::catchUp() {

@@ -16,14 +16,14 @@ TimedMonitor::TimedMonitor(ros::NodeHandle& nh, ros::NodeHandle& pnh) : MonitorN
   announce("");
 }
 
-void TimedMonitor::onState(int agent, const ros::MessageEvent<AgentState const>& event) {
-  if (!fromItsAgent(agent, event)) return;
+bool TimedMonitor::offer(int agent, const AgentState& msg, const std::string& publisher) {
   std::string why;
-  if (referee_->offerState(agent, *event.getConstMessage(), ros::WallTime::now().toSec(), why)) {
-    heard(agent, event);
-  } else {
+  if (!referee_->offerState(agent, msg, ros::WallTime::now().toSec(), why)) {
     drop(agent, why);
+    return false;
   }
+  heard(agent, publisher);
+  return true;
 }
 
 void TimedMonitor::begin() {

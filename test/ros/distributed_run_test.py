@@ -7,6 +7,8 @@ Private parameters:
   real_time_factor  > 0: the run is paced, and status k arrives about k h / r after status 0
   output_dir        where formation.launch writes the bag and the result file (removed after)
   injected          a foreign node forged states of agent_0: they must all have been dropped
+  nodelet           the agents ran in formation/manager: the monitor and the recorder took
+                    their states in the manager's batches (and, if injected, dropped forged ones)
 """
 import math
 import os
@@ -16,6 +18,7 @@ import threading
 import time
 import unittest
 
+import rosgraph
 import rospy
 import rostest
 from variational_formation.msg import FormationStatus
@@ -33,6 +36,7 @@ class DistributedRun(unittest.TestCase, vf_rostest.RunChecks):
         cls.expect = rospy.get_param("~expect", "converged")
         cls.rate = float(rospy.get_param("~real_time_factor", 0.0))
         cls.injected = bool(rospy.get_param("~injected", False))
+        cls.nodelet = bool(rospy.get_param("~nodelet", False))
         cls.out = rospy.get_param("~output_dir")
         cls.path = vf_rostest.scenario_path(cls.name)
         cls.scenario = vf_rostest.load_scenario(cls.path)
@@ -45,7 +49,14 @@ class DistributedRun(unittest.TestCase, vf_rostest.RunChecks):
 
         cls.sub = rospy.Subscriber("/formation/status", FormationStatus, on_status, queue_size=100000)
         name = os.path.basename(cls.path).replace(".yaml", "")
-        cls.result = vf_rostest.wait_for_result(os.path.join(cls.out, name + ".result.yaml"), 120.0)
+        # Until the run is over: who subscribed to what while it ran (the master's view).
+        master, cls.subscribers, end = rosgraph.Master("/distributed_run_test"), {}, time.time() + 120.0
+        cls.result = {}
+        while not cls.result and time.time() < end:
+            for topic, nodes in master.getSystemState()[1]:
+                cls.subscribers.setdefault(topic, set()).update(nodes)
+            cls.result = vf_rostest.wait_for_result(os.path.join(cls.out, name + ".result.yaml"), 0.0)
+            time.sleep(0.05)
         cls.recording = None
         if cls.result.get("result") == "succeeded":
             cls.recording = vf_rostest.Recording(os.path.join(cls.out, name + ".bag"))
@@ -98,6 +109,20 @@ class DistributedRun(unittest.TestCase, vf_rostest.RunChecks):
         due = (k1 - k0) * float(self.scenario["time_step"]) / self.rate
         self.assertGreater(t1 - t0, 0.95 * due)
         self.assertLess(t1 - t0, 1.5 * due + 1.0)
+
+    def test_states_come_batched_from_a_manager(self):
+        if not self.nodelet:
+            self.skipTest("agents in processes of their own: no manager batches")
+        subscribers = self.subscribers
+        for node in ("/formation/monitor", "/formation/recorder"):
+            self.assertIn(node, subscribers.get("/formation/manager/states", set()))
+            own = [t for t, nodes in subscribers.items() if t.endswith("/state") and node in nodes]
+            self.assertEqual(own, [], f"{node} still reads agents' own topics")
+        # The agents' own topics are still there for their neighbours, rostopic and rviz.
+        self.assertIn("/formation/agent_0/state", subscribers)
+        if self.injected:
+            self.assertGreater(rospy.get_param("/inject_forged/published_batches", 0), 50,
+                               "the forger published too few batches to test anything")
 
     def test_forged_states_were_dropped_and_counted(self):
         if not self.injected:

@@ -18,6 +18,7 @@
 #include "variational_formation/core/protocol/run_referee.hpp"
 #include "variational_formation/core/protocol/timed_referee.hpp"
 #include "variational_formation/ros/service_call.hpp"
+#include "variational_formation/ros/state_batch.hpp"
 
 namespace vf {
 
@@ -57,7 +58,10 @@ class MonitorNode {
   void announce(const std::string& recorder) const;
 
   // What the mode decides.
-  virtual void onState(int agent, const ros::MessageEvent<AgentState const>& event) = 0;
+  /// A state of `agent` that passed the identity checks, from `publisher`. @return accepted.
+  virtual bool offer(int agent, const AgentState& msg, const std::string& publisher) = 0;
+  /// After one or more accepted states (a state, or a manager's batch).
+  virtual void afterAccepted() {}
   virtual void begin() = 0;  ///< before spinning (a restarted lockstep monitor recovers here)
   virtual void watch() = 0;  ///< every 0.5 s
   virtual std::string waitingFor() const = 0;
@@ -69,11 +73,8 @@ class MonitorNode {
   Published publishSnapshot(const FormationSnapshot& s, const ros::Time& stamp, double dataAge, bool noetherHolds);
   /// Publishes `progress` (its header stamped with the completed step's simulated time).
   void publishProgress(const RunProgress& progress);
-  /// True if `event` came from the node that owns agent `agent` (or its manager), with its id and
-  /// no failure; otherwise counts a drop or ends the run on the agent's failure.
-  bool fromItsAgent(int agent, const ros::MessageEvent<AgentState const>& event);
-  /// Agent `agent` was heard (from the node or manager that published `event`).
-  void heard(int agent, const ros::MessageEvent<AgentState const>& event);
+  /// Agent `agent` was heard (from `publisher`: its node or its manager).
+  void heard(int agent, const std::string& publisher);
   void drop(int agent, const std::string& why);
   bool checkAlive(Participant& p, const std::string& what, double timeout);
   void reportWaiting(const std::string& line);
@@ -103,8 +104,13 @@ class MonitorNode {
 
  private:
   void writeResult(const std::string& result, const std::string& reason) const;
+  void onAgentTopic(int agent, const ros::MessageEvent<AgentState const>& event);
+  void onBatch(std::size_t source, const ros::MessageEvent<variational_formation::AgentStates const>& event);
+  /// A state from a sender allowed to speak for `agent`: ends the run on its failure, else offers it.
+  bool admit(int agent, const AgentState& msg, const std::string& publisher);
 
   std::vector<ros::Subscriber> subs_;
+  std::vector<BatchSource> batches_;  // managers whose agents come batched (doc/distributed.md, "Batches")
   ros::Publisher clockPub_;
   bool publishClock_ = false;  // ~publish_clock (lockstep): /clock follows the completed steps, never backwards
   ros::WallTimer watchTimer_;
@@ -129,7 +135,8 @@ class LockstepMonitor : public MonitorNode {
 
  private:
   using Referee = protocol::LockstepReferee<AgentState, Published>;
-  void onState(int agent, const ros::MessageEvent<AgentState const>& event) override;
+  bool offer(int agent, const AgentState& msg, const std::string& publisher) override;
+  void afterAccepted() override { publishCompleted(); }
   void begin() override;
   void watch() override;
   std::string waitingFor() const override { return referee_->waitingFor(recorder_.node); }
@@ -163,7 +170,7 @@ class TimedMonitor : public MonitorNode {
   TimedMonitor(ros::NodeHandle& nh, ros::NodeHandle& pnh);
 
  private:
-  void onState(int agent, const ros::MessageEvent<AgentState const>& event) override;
+  bool offer(int agent, const AgentState& msg, const std::string& publisher) override;
   void begin() override;
   void watch() override;
   std::string waitingFor() const override;

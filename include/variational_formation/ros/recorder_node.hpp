@@ -8,6 +8,7 @@
 #include <rosbag/bag.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "variational_formation/ros/state_batch.hpp"
 #include "variational_formation/AgentState.h"
 #include "variational_formation/FormationStatus.h"
 #include "variational_formation/RecallHistory.h"
@@ -57,6 +58,8 @@ class RecorderNode {
   template <typename M>
   void write(const std::string& topic, const M& msg, const ros::Time& stamp);
   void onState(int agent, const ros::MessageEvent<AgentState const>& event);
+  /// A manager's batch of its agents' states (doc/distributed.md, "Batches").
+  void onBatch(std::size_t source, const ros::MessageEvent<variational_formation::AgentStates const>& event);
   /// A state from the owner's topic or a fetched history: held until its step is written.
   void record(int agent, const AgentState::ConstPtr& msg);
   using Steps = protocol::StepAssembler<AgentState::ConstPtr, FormationStatus::ConstPtr,
@@ -88,6 +91,7 @@ class RecorderNode {
   double timeStep_ = 0.0;
   std::vector<std::string> owners_;
   std::vector<std::string> managers_;  // ~agent_manager: nodelet managers of agents
+  std::vector<BatchSource> batches_;    // those of them whose agents come batched
   RecordLedger states_;  // each state is held once; repeats are compared with it
   /// Steps not yet written (at most protocol::recorderLead of them); every stream of the steps it
   /// handed out is in the bag (or past its size limit).
