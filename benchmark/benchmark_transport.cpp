@@ -3,17 +3,22 @@
 // process, a ring with chords (neighbours i±1, i±2), each publishes AgentState step k + 1 as soon
 // as it holds its neighbours' step k; intra-process, as shared pointers, on one spinner thread.
 // One more subscriber stands for the monitor: on every agent's topic (--collector topics, the
-// pattern before batching) or on one batch topic that gets every state (--collector batch).
-// Prints the steps/s from the first publication to the last state collected.
+// pattern before batching) or on one batch topic that gets every state (--collector batch); in
+// this process, or with --remote in a second process (forked before ROS starts), over TCP as the
+// monitor gets them. Prints the steps/s from the first publication (remote: the first message
+// collected) to the last state collected.
 //
-// usage: benchmark_transport [--agents N] [--steps S] [--collector topics|batch]   (needs a master;
-//        benchmark/transport_ceiling.sh starts one)
+// usage: benchmark_transport [--agents N] [--steps S] [--collector topics|batch] [--remote]
+//        (needs a master; benchmark/transport_ceiling.sh starts one)
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
+
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <ros/ros.h>
 
@@ -77,6 +82,7 @@ struct Bench {
 
 int main(int argc, char** argv) {
   Bench b;
+  bool remote = false;
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
     const bool value = k + 1 < argc;
@@ -91,8 +97,10 @@ int main(int argc, char** argv) {
         return 2;
       }
       b.batch = c == "batch";
+    } else if (a == "--remote") {
+      remote = true;
     } else if (a == "--help" || a == "-h") {
-      std::puts("usage: benchmark_transport [--agents N] [--steps S] [--collector topics|batch]");
+      std::puts("usage: benchmark_transport [--agents N] [--steps S] [--collector topics|batch] [--remote]");
       return 0;
     } else {
       std::fprintf(stderr, "benchmark_transport: unknown or incomplete argument '%s' (see --help)\n", a.c_str());
@@ -103,13 +111,20 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "benchmark_transport: needs --agents >= 5 and --steps >= 1\n");
     return 2;
   }
-  ros::init(argc, argv, "benchmark_transport", ros::init_options::AnonymousName);
+  const pid_t collector = remote ? fork() : 0;
+  const bool collects = !remote || collector == 0;  // this process holds the collector
+  const bool runsAgents = !remote || collector > 0;
+  ros::init(argc, argv, collects && remote ? "benchmark_collector" : "benchmark_transport",
+            ros::init_options::AnonymousName | ros::init_options::NoSigintHandler);
   ros::NodeHandle nh("bench");
   b.agents.resize(static_cast<std::size_t>(b.n));
   b.pending = boost::make_shared<AgentStates>();
   const long total = static_cast<long>(b.n) * b.steps;  // states after step 0
-  auto done = std::chrono::steady_clock::now();
+  auto start = std::chrono::steady_clock::now(), done = start;
+  bool first = true;
   auto count = [&](long states) {
+    if (first && remote) start = std::chrono::steady_clock::now();
+    first = false;
     b.collected += states;
     if (b.collected >= total) {
       done = std::chrono::steady_clock::now();
@@ -124,30 +139,41 @@ int main(int argc, char** argv) {
     Agent& a = b.agents[static_cast<std::size_t>(i)];
     for (int d : {-2, -1, 1, 2}) a.neighbours.push_back((i + d + b.n) % b.n);
     a.heard.assign(a.neighbours.size(), 0);
-    for (std::size_t k = 0; k < a.neighbours.size(); ++k) {
+    for (std::size_t k = 0; runsAgents && k < a.neighbours.size(); ++k) {
       b.subs.push_back(nh.subscribe<AgentState>("agent_" + std::to_string(a.neighbours[k]), 1000,
                                                 [&b, i, k](const AgentState::ConstPtr& m) { b.onNeighbour(i, k, m); }));
     }
-    if (!b.batch) {
+    if (collects && !b.batch) {
       b.subs.push_back(nh.subscribe<AgentState>("agent_" + std::to_string(i), 1000,
                                                 [&count](const AgentState::ConstPtr& m) { count(m->step > 0 ? 1 : 0); }));
     }
   }
-  if (b.batch) {
+  if (collects && b.batch) {
     b.subs.push_back(nh.subscribe<AgentStates>("states", 1000, [&count](const AgentStates::ConstPtr& m) {
       long states = 0;
       for (const auto& s : m->states) states += s.step > 0 ? 1 : 0;
       count(states);
     }));
   }
-  // Let every connection come up, then start: every agent publishes step 0.
-  ros::WallDuration(1.0).sleep();
-  for (int i = 0; i < 20 && ros::ok(); ++i) ros::spinOnce();
-  const auto start = std::chrono::steady_clock::now();
-  for (int i = 0; i < b.n; ++i) b.publish(i);
-  ros::spin();
+  if (!runsAgents) {  // the remote collector: count until everything came
+    ros::spin();
+  } else {
+    // Let every connection come up (the remote collector's too), then start: step 0 of every agent.
+    ros::WallDuration(remote ? 3.0 : 1.0).sleep();
+    for (int i = 0; i < 20 && ros::ok(); ++i) ros::spinOnce();
+    start = std::chrono::steady_clock::now();
+    for (int i = 0; i < b.n; ++i) b.publish(i);
+    if (!remote) {
+      ros::spin();
+    } else {  // serve the collector until it exits
+      int status = 0;
+      while (waitpid(collector, &status, WNOHANG) == 0) ros::spinOnce();
+      return WIFEXITED(status) ? WEXITSTATUS(status) : 1;
+    }
+  }
   const double seconds = std::chrono::duration<double>(done - start).count();
-  std::printf("benchmark_transport: %d agents, %ld steps, collector %s: %.3f s, %.0f steps/s\n", b.n, b.steps,
-              b.batch ? "batch" : "topics", seconds, b.steps / seconds);
+  std::printf("benchmark_transport: %d agents, %ld steps, collector %s%s: %.3f s, %.0f steps/s\n", b.n, b.steps,
+              b.batch ? "batch" : "topics", remote ? " (another process)" : " (this process)", seconds,
+              b.steps / seconds);
   return b.collected >= total ? 0 : 1;
 }

@@ -4,9 +4,10 @@ add_library(variational_formation_ros src/ros/agent_node.cpp src/ros/markers.cpp
   src/ros/participants.cpp
   src/ros/recorder_node.cpp)
 # The time-driven agent (doc/robots.md), selected by the agent's ~mode.
-target_sources(variational_formation_ros PRIVATE src/ros/timed_agent_node.cpp)
+target_sources(variational_formation_ros PRIVATE src/ros/timed_agent_node.cpp src/ros/timed_agent_outputs.cpp)
 # The monitor's two modes over its shared wiring, and the bounded pool of service calls.
-target_sources(variational_formation_ros PRIVATE src/ros/lockstep_monitor.cpp src/ros/timed_monitor.cpp
+target_sources(variational_formation_ros PRIVATE src/ros/lockstep_monitor.cpp src/ros/timed_monitor.cpp src/ros/monitor_outputs.cpp
+  src/ros/recorder_bag.cpp
   src/ros/service_call.cpp src/ros/state_batch.cpp)
 add_dependencies(variational_formation_ros ${PROJECT_NAME}_gencfg)
 # catkin's include path is given to each ROS target privately (never exported: catkin_lint).
@@ -95,7 +96,7 @@ endif()
 # real one (cmd_vel in; nav_msgs/Odometry and tf out).
 add_executable(robot_sim src/ros/robot_sim_main.cpp src/ros/robot_sim_node.cpp)
 target_include_directories(robot_sim SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
-target_link_libraries(robot_sim variational_formation_core ${catkin_LIBRARIES})
+target_link_libraries(robot_sim variational_formation_ros variational_formation_core ${catkin_LIBRARIES})
 target_compile_options(robot_sim PRIVATE ${VF_FLAGS})
 add_dependencies(robot_sim ${catkin_EXPORTED_TARGETS})
 install(TARGETS robot_sim RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

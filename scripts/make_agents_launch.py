@@ -83,8 +83,8 @@ def non_negative_int(flag):
 
 def manager(args, ids):
     """The agents' nodelet manager, which loads every agent in `ids` (in that order) itself.
-    Worker threads 0 means: one up to 10 agents, four beyond (doc/distributed.md, "Threads")."""
-    threads = args.nodelet_threads if int(args.nodelet_threads) > 0 else ("1" if len(ids) <= 10 else "4")
+    Threads 0 means one (doc/distributed.md, "Threads")."""
+    threads = args.nodelet_threads if int(args.nodelet_threads) > 0 else "1"
     lines = ['  <node name="manager" ns="formation" pkg="variational_formation" type="agent_manager" clear_params="true"',
              f'        respawn={quoteattr(args.respawn)} output="screen">']
     for name, kind, value in (("agents", "str", " ".join(str(i) for i in ids)), ("scenario", "str", args.scenario),

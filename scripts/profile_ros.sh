@@ -8,6 +8,7 @@
 #   - perf's split of its samples by library: kernel, roscpp (roscpp, serialisation, xmlrpc,
 #     rosconsole, cpp_common), libc/libstdc++ (locks, allocation), tf2, the package's ROS layer,
 #     the package's core (the maths), other.
+# VF_PROFILE_SYMBOLS=N also prints each process's N functions with the most samples.
 # With extra launch arguments after "--" (e.g. -- record:=true marker_every:=10) they are added
 # to every run.
 # usage: ./scripts/profile_ros.sh [agent counts...] [-- formation.launch args...]   (default 50 100)
@@ -103,6 +104,11 @@ for n in "${counts[@]}"; do
     [ -f "$tmp/$name.data" ] || continue
     echo "  $name$([ "$name" = manager ] && echo " (all $n agents)"), samples by library:"
     split_by_library "$tmp/$name.data"
+    if [ "${VF_PROFILE_SYMBOLS:-0}" -gt 0 ]; then
+      echo "  $name, the ${VF_PROFILE_SYMBOLS} functions with the most samples (self):"
+      perf report -i "$tmp/$name.data" --no-children --sort sym -g none --percent-limit 0.5 2>/dev/null |
+        grep -E '^ +[0-9.]+%' | head -n "$VF_PROFILE_SYMBOLS" | sed -E 's/^ +/    /'
+    fi
     rm -f "$tmp/$name.data"
   done
 done

@@ -8,6 +8,7 @@
 // ~scenario, ~real_time_factor, ~monitor, ~agent_manager passed on to every agent (AgentNode
 // checks them); nodelet itself reads ~num_worker_threads.
 #include <cmath>
+#include <thread>
 #include <string>
 #include <vector>
 
@@ -70,7 +71,18 @@ int main(int argc, char** argv) {
     struct StopBatch {
       ~StopBatch() { vf::StateBatch::stop(); }  // after the loader (declared below) unloaded the agents
     } stopBatch;
+    // The agents' callbacks run on this process's own threads, one per ~num_worker_threads (0:
+    // one per core, as nodelet counts), not on nodelet's queue manager.
+    const int threads = vf::optionalParam(pnh, "num_worker_threads", 0);
+    if (threads < 0) throw vf::InvalidInput("~num_worker_threads: must be >= 0, got " + std::to_string(threads));
+    vf::AgentThreads::start(threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+    struct EndThreads {
+      ~EndThreads() { vf::AgentThreads::stop(); }  // after the loader unloaded the agents
+    } endThreads;
     nodelet::Loader loader(pnh);  // the load_nodelet, unload_nodelet and list services, on the global queue
+    struct HaltThreads {
+      ~HaltThreads() { vf::AgentThreads::local()->halt(); }  // before: no agent callback runs while unloading
+    } haltThreads;
     ros::AsyncSpinner spinner(1);
     spinner.start();
     for (std::size_t k = 0; k < ids.size() && ros::ok(); ++k) {

@@ -1,15 +1,12 @@
 #include "variational_formation/ros/monitor_node.hpp"
 
 #include <fstream>
-#include <limits>
 
 #include <ros/callback_queue.h>
 #include <rosgraph_msgs/Clock.h>
 
 #include "variational_formation/core/number_checks.hpp"
-#include "variational_formation/core/run_outcome.hpp"
 #include "variational_formation/core/scenario.hpp"
-#include "variational_formation/ros/markers.hpp"
 #include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/participants.hpp"
@@ -58,8 +55,10 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh, bool timed) 
   std::vector<bool> batched(static_cast<std::size_t>(n), false);
   for (std::size_t m = 0; m < batches_.size(); ++m) {
     for (int id : batches_[m].ids) batched[static_cast<std::size_t>(id)] = true;
+    // As deep as the agents' own topics together: a batch may hold a single state.
+    const uint32_t depth = static_cast<uint32_t>((2 * window_ + 10) * static_cast<long>(batches_[m].ids.size()));
     subs_.push_back(nh.subscribe<variational_formation::AgentStates>(
-        batches_[m].manager + "/states", static_cast<uint32_t>(2 * window_ + 10),
+        batches_[m].manager + "/states", depth,
         boost::function<void(const ros::MessageEvent<variational_formation::AgentStates const>&)>(
             [this, m](const ros::MessageEvent<variational_formation::AgentStates const>& e) { onBatch(m, e); }),
         ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
@@ -140,59 +139,6 @@ void MonitorNode::drop(int agent, const std::string& why) {
                     dropped_);
 }
 
-MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, const ros::Time& stamp,
-                                                    double dataAge, bool noetherHolds) {
-  const ros::WallTime now = ros::WallTime::now();
-  if (s.metrics.step == 0) firstStepAt_ = now;
-  lastCompletedAt_ = now;
-  for (std::size_t i = 0; i < trails_.size(); ++i) {
-    Eigen::Vector3d p = Eigen::Vector3d::Zero();
-    p.head(s.positions.rows()) = s.positions.col(static_cast<Eigen::Index>(i));
-    trails_[i].push_back(p);
-    if (static_cast<int>(trails_[i].size()) > trailLength_) trails_[i].pop_front();
-  }
-  Published out;
-  FormationStatus& status = out.first;
-  status = toStatusMessage(s);
-  status.header.stamp = stamp;
-  status.dropped = static_cast<uint32_t>(dropped_);
-  status.max_data_age = dataAge;
-  if (!noetherHolds) {
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    status.linear_momentum_predicted.x = status.linear_momentum_predicted.y = status.linear_momentum_predicted.z = nan;
-    status.angular_momentum_predicted.x = status.angular_momentum_predicted.y = nan;
-    status.angular_momentum_predicted.z = nan;
-  }
-  statusPub_.publish(status);
-  // Never backwards: with several formations on one master, the one furthest ahead sets it.
-  if (publishClock_ && (!ros::Time::isSimTime() || stamp >= ros::Time::now())) {
-    rosgraph_msgs::Clock clock;
-    clock.clock = stamp;
-    clockPub_.publish(clock);
-  }
-  // Markers cost O(n x trail length) per step: built only when someone takes them (the recorder,
-  // a viewer), every marker_every steps, and always at the first and last step so that the
-  // latched one is right. The trails above still get every step.
-  const long last = scenario_.steps;
-  const bool edge = s.metrics.step == 0 || (last > 0 && s.metrics.step == last);
-  if (edge || (s.metrics.step % markerEvery_ == 0 && (recording_ || markersPub_.getNumSubscribers() > 0))) {
-    out.second = makeMarkers(s, measure().formation(), trails_);
-    for (auto& m : out.second.markers) m.header.stamp = stamp;
-    markersPub_.publish(out.second);
-  }
-  convergedStep_ = s.converged ? s.convergedStep : -1;
-  finalError_ = s.metrics.maxDistanceError;
-  if (s.converged && reportedConvergence_ != s.convergedStep) {
-    ROS_INFO("monitor: congruent with the desired shape since step %ld (t = %.3f s)", s.convergedStep,
-             s.convergedStep * scenario_.timeStep);
-    reportedConvergence_ = s.convergedStep;
-  } else if (!s.converged && reportedConvergence_ >= 0) {
-    ROS_INFO("monitor: left the desired shape at step %ld", s.metrics.step);
-    reportedConvergence_ = -2;
-  }
-  return out;
-}
-
 void MonitorNode::publishProgress(const RunProgress& progress) {
   progress_ = progress;
   progress_.header.stamp.fromSec(std::max(0L, static_cast<long>(progress.completed_step)) * scenario_.timeStep);
@@ -203,7 +149,7 @@ bool MonitorNode::checkAlive(Participant& p, const std::string& what, double tim
   if (!p.seen) return true;  // not started yet: the waiting line says so
   // An agent in a nodelet manager has no node of its own: its host is the manager.
   const Liveness l = nodeLiveness(p.host.empty() ? p.node : p.host);
-  if (l == Liveness::Alive) {
+  if (l == Liveness::Alive || l == Liveness::Busy) {
     p.goneSince = ros::WallTime();
     return true;
   }
@@ -224,50 +170,6 @@ void MonitorNode::reportWaiting(const std::string& line) {
   if (secondsSince(lastReportAt_) < 5.0) return;  // a line every 5 s at most
   ROS_INFO("monitor: %s", line.c_str());
   lastReportAt_ = ros::WallTime::now();
-}
-
-void MonitorNode::writeResult(const std::string& result, const std::string& reason) const {
-  if (resultFile_.empty()) return;
-  std::ofstream f(resultFile_);
-  std::string quoted;
-  for (char c : reason) quoted += c == '"' ? std::string("\\\"") : std::string(1, c);
-  const FormationOutcome formation = formationOutcome(convergedStep_, finalError_, scenario_.timeStep);
-  f << "result: " << result << "\nscenario: " << scenario_.name << "\nsteps: " << scenario_.steps
-    << "\ncompleted_step: " << completedStep() << "\nconverged_step: " << convergedStep_ << "\nformation: \""
-    << formation.line << "\"\nfinal_max_distance_error: " << finalError_ << "\ndropped: " << dropped_
-    << "\nreason: \"" << quoted << "\"\n";
-  if (!f) ROS_ERROR("monitor: cannot write the result file %s", resultFile_.c_str());
-}
-
-void MonitorNode::finish(uint8_t state, std::string reason) {
-  if (ended()) return;
-  const long last = completedStep();
-  const double h = scenario_.timeStep;
-  const FormationOutcome formation = formationOutcome(convergedStep_, finalError_, h);
-  const RunVerdict verdict = finishedRunVerdict(scenario_, formation);
-  if (state == RunProgress::FINISHED) {
-    const double seconds = (ros::WallTime::now() - firstStepAt_).toSec();
-    ROS_INFO("monitor: %ld steps in %.3f s: %.0f steps/s, real-time factor %.1f at h = %g; %s; %ld dropped", last,
-             seconds, last / seconds, last * h / seconds, h, formation.line.c_str(), dropped_);
-  }
-  if (state == RunProgress::FINISHED && !verdict.succeeded) {
-    state = RunProgress::FAILED;  // the scenario asked for a formation that did not form
-    reason = verdict.reason;
-  }
-  if (state == RunProgress::FINISHED) {
-    writeResult("succeeded", "");
-    // The last line says whether the formation formed: a run that never formed is no plain success.
-    ROS_INFO("monitor: run succeeded; formation %s (%s)", formation.line.c_str(),
-             resultFile_.empty() ? "no result file" : resultFile_.c_str());
-    exitStatus_ = 0;
-  } else {
-    writeResult("failed", reason);
-    ROS_ERROR("monitor: run failed at step %ld: %s", last, reason.c_str());
-    exitStatus_ = 1;
-  }
-  progress_.state = state;
-  progress_.reason = reason;
-  progressPub_.publish(progress_);
 }
 
 int MonitorNode::run() {

@@ -1,11 +1,11 @@
 #include "variational_formation/ros/robot_sim_node.hpp"
 
-#include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
 
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/number_checks.hpp"
 #include "variational_formation/ros/parameters.hpp"
+#include "variational_formation/ros/participants.hpp"
 
 namespace vf {
 
@@ -104,15 +104,10 @@ void RobotSimNode::publish(const ros::Time& stamp) {
   odom.twist.twist.linear.z = planar ? 0.0 : v[2];
   odomPub_.publish(odom);
 
-  geometry_msgs::TransformStamped t;
-  t.header.stamp = stamp;
-  t.header.frame_id = "world";
-  t.child_frame_id = childFrame_;
-  t.transform.translation.x = p[0];
-  t.transform.translation.y = p[1];
-  t.transform.translation.z = planar ? 0.0 : p[2];
-  t.transform.rotation.w = 1.0;
-  tf_.sendTransform(t);
+  std_msgs::Header header;
+  header.stamp = stamp;
+  header.frame_id = "world";
+  tf_.sendTransform(frameAt(header, childFrame_, {p[0], p[1], planar ? 0.0 : p[2]}));
 }
 
 }  // namespace vf

@@ -23,12 +23,33 @@ StateBatch* StateBatch::local() { return gBatch.get(); }
 
 StateBatch::StateBatch(ros::NodeHandle& pnh, const std::vector<int>& ids)
     : ids_(ids.begin(), ids.end()), pending_(boost::make_shared<variational_formation::AgentStates>()) {
+  // The outgoing queue of each subscriber holds as many batches as 250 steps of single states
+  // (more than twice the default window): a subscriber that is briefly busy loses nothing.
+  const uint32_t depth = static_cast<uint32_t>(std::max<std::size_t>(1000, 250 * ids_.size()));
   ros::AdvertiseOptions options = ros::AdvertiseOptions::create<variational_formation::AgentStates>(
-      "states", 1000, [this](const ros::SingleSubscriberPublisher& s) { onConnect(s); },
+      "states", depth, [this](const ros::SingleSubscriberPublisher& s) { onConnect(s); },
       ros::SubscriberStatusCallback(), ros::VoidConstPtr(), nullptr);
   pub_ = pnh.advertise(options);
   pending_->states.reserve(ids_.size());
-  timer_ = pnh.createWallTimer(ros::WallDuration(kFlushAfter), [this](const ros::WallTimerEvent&) { flush(); });
+  flusher_ = std::thread([this] { flushEvery5ms(); });
+}
+
+StateBatch::~StateBatch() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+  }
+  stop_.notify_all();
+  flusher_.join();
+}
+
+void StateBatch::flushEvery5ms() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (!stop_.wait_for(lock, std::chrono::duration<double>(kFlushAfter), [this] { return stopping_; })) {
+    lock.unlock();
+    flush();
+    lock.lock();
+  }
 }
 
 void StateBatch::add(const variational_formation::AgentState::ConstPtr& state) {
@@ -66,6 +87,40 @@ void StateBatch::onConnect(const ros::SingleSubscriberPublisher& subscriber) {
     for (const auto& held : newest_) newest.states.push_back(*held.second);
   }
   if (!newest.states.empty()) subscriber.publish(newest);
+}
+
+namespace {
+std::unique_ptr<AgentThreads> gThreads;  // this process's, if it is an agent manager
+}  // namespace
+
+void AgentThreads::start(int threads) { gThreads.reset(new AgentThreads(threads)); }
+
+void AgentThreads::stop() { gThreads.reset(); }
+
+AgentThreads* AgentThreads::local() { return gThreads.get(); }
+
+AgentThreads::AgentThreads(int threads) {
+  for (int k = 0; k < std::max(1, threads); ++k) queues_.push_back(std::make_unique<ros::CallbackQueue>());
+  for (auto& q : queues_) {
+    threads_.emplace_back([this, queue = q.get()] {
+      while (!stopping_) queue->callAvailable(ros::WallDuration(0.1));
+    });
+  }
+}
+
+AgentThreads::~AgentThreads() { halt(); }
+
+void AgentThreads::halt() {
+  stopping_ = true;
+  for (auto& q : queues_) q->disable();  // wakes a thread waiting in callAvailable
+  for (std::thread& t : threads_) {
+    if (t.joinable()) t.join();
+  }
+}
+
+ros::CallbackQueue* AgentThreads::nextQueue() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return queues_[next_++ % queues_.size()].get();
 }
 
 std::vector<int> parseAgentIds(const std::string& list, const std::string& parameter) {

@@ -3,7 +3,6 @@
 #include <cmath>
 
 #include <geometry_msgs/PoseStamped.h>
-#include <geometry_msgs/TransformStamped.h>
 #include <geometry_msgs/Twist.h>
 #include <ros/callback_queue.h>
 
@@ -129,50 +128,6 @@ void TimedAgentNode::onOdometry(const nav_msgs::Odometry& odom) {
   haveOdometry_ = true;
 }
 
-void TimedAgentNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  const double t = now();
-  const double rate = diagnosedAt_ > 0.0 && t > diagnosedAt_ ? (agent_->step() - diagnosedStep_) / (t - diagnosedAt_) : 0.0;
-  diagnosedStep_ = agent_->step();
-  diagnosedAt_ = t;
-  if (exitStatus_ >= 0 || agent_->finished()) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "run over");
-  } else if (!running_) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "waiting for the monitor to start the run");
-  } else if (robot_ && !haveOdometry_) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "holding: no odometry yet");
-  } else if (agent_->holding()) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "holding: a neighbour is silent");
-  } else {
-    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "stepping");
-  }
-  status.add("step", agent_->step());
-  status.add("step rate [1/s]", rate);
-  status.add("expected step rate [1/s]", rate_ / h_);
-  status.add("holding", agent_->holding());
-  status.add("held ticks", agent_->heldTicks());
-  status.add("states lost (injected)", faults_->lost());
-  status.add("states refused (outdated or malformed)", agent_->dropped());
-  status.add("states dropped (not from the owner)", dropped_);
-  status.add("kappa [1/s]", agent_->dampingGain());
-  for (const TimedAgent::NeighbourStatus& n : agent_->neighbourStatus(t)) {
-    const std::string who = "agent_" + std::to_string(n.id);
-    status.add(who + " age [s]", n.heard ? n.age : -1.0);
-    status.add(who + " accepted", n.accepted);
-    status.add(who + " dropped", n.dropped);
-  }
-}
-
-void TimedAgentNode::onReconfigure(variational_formation::TimedAgentConfig& config, uint32_t) {
-  if (config.kappa == agent_->dampingGain()) return;
-  try {
-    agent_->setDampingGain(config.kappa);
-    ROS_INFO("%s: kappa set to %g at step %ld", name_.c_str(), config.kappa, agent_->step());
-  } catch (const std::exception& e) {
-    ROS_WARN("%s: kappa not changed: %s", name_.c_str(), e.what());
-    config.kappa = agent_->dampingGain();
-  }
-}
-
 void TimedAgentNode::onTick() {
   diagnostics_.update();  // rate-limited by the updater itself (~diagnostic_period, 1 s)
   const double t = now();
@@ -232,47 +187,6 @@ void TimedAgentNode::onTick() {
   }
   publish();
   if (robot_ && agent_->finished()) cmdVelPub_.publish(geometry_msgs::Twist());  // our last step: stop the robot
-}
-
-void TimedAgentNode::publish() {
-  AgentState msg;
-  msg.header.stamp.fromSec(agent_->step() * h_);  // the simulated time of the step
-  msg.header.frame_id = "world";
-  msg.id = static_cast<uint32_t>(agent_->id());
-  msg.step = agent_->step();
-  msg.time = agent_->step() * h_;
-  msg.position = agent_->position();
-  msg.previous_position = agent_->previousPosition();
-  msg.dropped = static_cast<uint32_t>(dropped_ + agent_->dropped());
-  statePub_.publish(msg);
-  lastPublishAt_ = ros::WallTime::now();
-
-  geometry_msgs::PoseStamped pose;
-  pose.header = msg.header;
-  pose.pose.position.x = msg.position[0];
-  pose.pose.position.y = msg.position[1];
-  pose.pose.position.z = msg.position.size() > 2 ? msg.position[2] : 0.0;
-  pose.pose.orientation.w = 1.0;
-  posePub_.publish(pose);
-
-  geometry_msgs::TransformStamped t;
-  t.header = msg.header;
-  t.child_frame_id = frame_;
-  t.transform.translation.x = pose.pose.position.x;
-  t.transform.translation.y = pose.pose.position.y;
-  t.transform.translation.z = pose.pose.position.z;
-  t.transform.rotation.w = 1.0;
-  tf_.sendTransform(t);
-
-  if (robot_) {
-    setpointPub_.publish(pose);
-    geometry_msgs::Twist cmd;
-    const std::vector<double>& v = agent_->commandedVelocity();
-    cmd.linear.x = v[0];
-    cmd.linear.y = v[1];
-    cmd.linear.z = v.size() > 2 ? v[2] : 0.0;
-    cmdVelPub_.publish(cmd);
-  }
 }
 
 void TimedAgentNode::reportWaiting() {

@@ -85,12 +85,14 @@ bool fromAgent(const Event& event, const std::string& owner, const std::vector<s
 }
 
 /// What the master and the node's own XML-RPC port say about a node.
-enum class Liveness { Alive, NotRegistered, NotAnswering };
+enum class Liveness { Alive, NotRegistered, NotAnswering, Busy };
 
 /**
  * Asks the master for the node's URI and connects to it (0.5 s at most). A node that was killed
  * with SIGKILL stays registered, but its port refuses connections: NotAnswering. A stopped
- * (SIGSTOP) node still accepts connections: Alive. Blocks for at most about a second.
+ * (SIGSTOP) node still accepts connections: Alive. Busy when the master's call or the connection
+ * times out instead of being refused (a master or manager busy registering a thousand agents):
+ * not evidence of death. Blocks for at most about a second.
  */
 Liveness nodeLiveness(const std::string& fullName);
 
