@@ -5,7 +5,8 @@ target_sources(variational_formation_core PRIVATE
   src/core/delayed_integrator.cpp
   src/core/delay_margin.cpp
   src/core/delay_campaign.cpp
-  src/core/robot_mode.cpp)
+  src/core/robot_mode.cpp
+  src/core/robot_link.cpp)
 target_sources(variational_formation_tools PRIVATE
   src/tools/progress.cpp
   src/tools/delay_margin_cli.cpp)
@@ -20,9 +21,11 @@ if(CATKIN_ENABLE_TESTING)
   target_link_libraries(test_delayed_integrator variational_formation_core gtest_main)
   catkin_add_gtest(test_robot_mode test/core/test_robot_mode.cpp)
   target_link_libraries(test_robot_mode variational_formation_core gtest_main)
+  catkin_add_gtest(test_robot_link test/core/test_robot_link.cpp)
+  target_link_libraries(test_robot_link variational_formation_core gtest_main)
   catkin_add_gtest(test_delay_margin test/tools/test_delay_margin.cpp)
   target_link_libraries(test_delay_margin variational_formation_tools gtest_main)
-  foreach(t test_delayed_integrator test_robot_mode test_delay_margin)
+  foreach(t test_delayed_integrator test_robot_mode test_robot_link test_delay_margin)
     target_compile_options(${t} PRIVATE ${VF_FLAGS})
     target_compile_definitions(${t} PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   endforeach()

@@ -9,6 +9,7 @@
 #include "variational_formation/core/hand_point.hpp"
 #include "variational_formation/core/number_checks.hpp"
 #include "variational_formation/core/point_robot.hpp"
+#include "variational_formation/core/robot_link.hpp"
 #include "variational_formation/core/timed_agent.hpp"
 #include "variational_formation/core/unicycle_robot.hpp"
 #include "variational_formation/core/validation.hpp"
@@ -61,11 +62,11 @@ void correctedPosition(const std::vector<double>& integrated, const std::vector<
 
 namespace {
 
-// One simulated robot as the loop sees it: its point (hand point for a unicycle).
+// One simulated robot: PointRobot, or UnicycleRobot whose hand point is the agent's point.
 class LoopRobot {
  public:
   LoopRobot(const RobotLoopSettings& s, const std::vector<double>& start, double heading, std::uint64_t seed)
-      : settings_(s) {
+      : handOffset_(s.handOffset), initialHeading_(heading) {
     if (s.kinematics == RobotKinematics::Holonomic) {
       PointRobotSettings p;
       p.lag = s.lag;
@@ -75,43 +76,29 @@ class LoopRobot {
       point_ = std::make_unique<PointRobot>(p, start, seed);
     } else {
       if (start.size() != 2) throw InvalidInput("kinematics: unicycle robots need a planar scenario");
-      hand_.handOffset = s.handOffset;
-      hand_.maxSpeed = s.maxSpeed;
-      hand_.maxTurnRate = s.maxTurnRate;
       UnicycleRobotSettings u;
       u.lag = s.lag;
       u.maxSpeed = s.maxSpeed;
       u.maxTurnRate = s.maxTurnRate;
       u.odometryNoise = s.odometryNoise;
       u.headingNoise = s.headingNoise;
-      initialHeading_ = heading;
       unicycle_ = std::make_unique<UnicycleRobot>(u, axleFromHandPoint(start.data(), heading, s.handOffset), seed);
     }
   }
-  // Odometry: the measured point; for a unicycle also the measured heading.
-  std::vector<double> measure() {
-    if (point_) return point_->measuredPosition();
-    const PlanarPose pose = unicycle_->measuredPose();
-    measuredHeading_ = pose.heading;
-    std::vector<double> p(2);
-    handPoint(pose, hand_.handOffset, p.data());
-    return p;
+  // Odometry, as the agent's link takes it.
+  void measure(RobotLink& link) {
+    if (point_) link.measurePoint(point_->measuredPosition());
+    else link.measurePose(unicycle_->measuredPose());
   }
   std::vector<double> truePoint() const {
     if (point_) return point_->position();
     std::vector<double> p(2);
-    handPoint(unicycle_->pose(), hand_.handOffset, p.data());
+    handPoint(unicycle_->pose(), handOffset_, p.data());
     return p;
   }
-  // A commanded velocity of the point [m/s]; for a unicycle at the last measured heading.
-  bool command(const std::vector<double>& u) {
-    if (point_) {
-      point_->setCommand(u);
-      return false;
-    }
-    const UnicycleCommand c = handPointCommand(hand_, measuredHeading_, u[0], u[1]);
-    unicycle_->setCommand(c.linear, 0.0, c.angular);
-    return c.saturated;
+  void command(const RobotLink::Command& c) {
+    if (point_) point_->setCommand(std::vector<double>(c.linear, c.linear + point_->dimension()));
+    else unicycle_->setCommand(c.linear[0], c.linear[1], c.angular);
   }
   void advance(double dt) {
     if (point_) point_->advance(dt);
@@ -124,12 +111,10 @@ class LoopRobot {
   }
 
  private:
-  RobotLoopSettings settings_;
-  HandPointSettings hand_;
+  double handOffset_;
+  double initialHeading_;
   std::unique_ptr<PointRobot> point_;
   std::unique_ptr<UnicycleRobot> unicycle_;
-  double measuredHeading_ = 0.0;
-  double initialHeading_ = 0.0;
 };
 
 // max over all pairs of | |p_i - p_j| - |q*_i - q*_j| | [m].
@@ -158,11 +143,21 @@ RobotLoopResult runRobotLoop(const Scenario& scenario, const RobotLoopSettings& 
   requireFiniteAbove("tolerance", s.tolerance, 0.0, "m");
   const int n = scenario.agentCount();
   const double h = scenario.timeStep;
-  const double kp = s.trackingGain >= 0.0 ? s.trackingGain : 1.0 / (4.0 * (s.lag + h));
+  RobotLinkSettings linkSettings;
+  linkSettings.kinematics = s.kinematics;
+  linkSettings.feedback = s.feedback;
+  linkSettings.hand.handOffset = s.handOffset;
+  linkSettings.hand.maxSpeed = s.maxSpeed;
+  linkSettings.hand.maxTurnRate = s.maxTurnRate;
+  linkSettings.lag = s.lag;
+  linkSettings.correctionTime = s.correctionTime;
+  linkSettings.trackingGain = s.trackingGain;
   std::vector<TimedAgent> agents;
   std::vector<LoopRobot> robots;
+  std::vector<RobotLink> links;
   for (int i = 0; i < n; ++i) {
     agents.emplace_back(scenario, i, 1.0);
+    links.emplace_back(linkSettings, scenario.dimension, h);
     const std::vector<double> start(scenario.initialPositions.col(i).data(),
                                     scenario.initialPositions.col(i).data() + scenario.dimension);
     const double heading = scenario.initialHeadings.empty() ? drawInitialHeading(s.headingSeed, i)
@@ -181,21 +176,11 @@ RobotLoopResult runRobotLoop(const Scenario& scenario, const RobotLoopSettings& 
       }
     }
     for (int i = 0; i < n; ++i) {
-      const std::vector<double> measured = robots[i].measure();
-      if (s.feedback == RobotFeedback::Odometry) {
-        agents[i].setMeasuredPosition(measured);
-      } else {
-        correctedPosition(agents[i].position(), measured, h, s.correctionTime, start);
-        agents[i].setMeasuredPosition(start);
-      }
+      robots[i].measure(links[i]);
+      links[i].startPosition(agents[i].position(), start);
+      agents[i].setMeasuredPosition(start);
       agents[i].tick(now);
-      std::vector<double> u = agents[i].commandedVelocity();
-      if (s.feedback == RobotFeedback::Integrated) {
-        // Track q_k, where the robot should be now, with the velocity as feed-forward.
-        const std::vector<double>& target = agents[i].previousPosition();
-        for (std::size_t a = 0; a < u.size(); ++a) u[a] += kp * (target[a] - measured[a]);
-      }
-      if (robots[i].command(u)) ++result.saturatedCommands;
+      robots[i].command(links[i].command(agents[i].commandedVelocity(), agents[i].previousPosition()));
     }
     std::vector<std::vector<double>> points;
     for (LoopRobot& robot : robots) {
@@ -211,6 +196,7 @@ RobotLoopResult runRobotLoop(const Scenario& scenario, const RobotLoopSettings& 
     if (k >= lastSecond) result.maxErrorLastSecond = std::max(result.maxErrorLastSecond, error);
     result.finalError = error;
   }
+  for (const RobotLink& link : links) result.saturatedCommands += link.saturatedCommands();
   result.convergedTime = result.convergedStep >= 0 ? result.convergedStep * h : -1.0;
   for (const LoopRobot& robot : robots) result.maxHeadingChange = std::max(result.maxHeadingChange, robot.headingChange());
   return result;
