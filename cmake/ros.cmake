@@ -4,7 +4,8 @@ add_library(variational_formation_ros src/ros/agent_node.cpp src/ros/markers.cpp
   src/ros/participants.cpp
   src/ros/recorder_node.cpp)
 # The time-driven agent (doc/robots.md), selected by the agent's ~mode.
-target_sources(variational_formation_ros PRIVATE src/ros/timed_agent_node.cpp src/ros/timed_agent_outputs.cpp)
+target_sources(variational_formation_ros PRIVATE src/ros/timed_agent_node.cpp src/ros/timed_agent_outputs.cpp
+  src/ros/timed_agent_robot.cpp)
 # The monitor's two modes over its shared wiring, and the bounded pool of service calls.
 target_sources(variational_formation_ros PRIVATE src/ros/lockstep_monitor.cpp src/ros/timed_monitor.cpp src/ros/monitor_outputs.cpp
   src/ros/recorder_bag.cpp
@@ -76,7 +77,17 @@ if(CATKIN_ENABLE_TESTING)
   target_include_directories(test_call_pool SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
   target_link_libraries(test_call_pool variational_formation_ros gtest_main)
   target_compile_options(test_call_pool PRIVATE ${VF_FLAGS})
-  add_rostest(test/ros/robots_run.test)
+  # Simulated robots (test/ros/robots_run.test): the hexagon with holonomic robots and with
+  # unicycles from seeded headings; ring7 (delay margin 0.05 s) with lags 0.1 and 0.3 s.
+  foreach(case "case:=hexagon"
+               "case:=hexagon_unicycle kinematics:=unicycle heading_seed:=7 world_frame:=map"
+               "case:=ring7_lag0.1 scenario:=ring7 lag:=0.1 time_limit:=90 expect_lag_warning:=true"
+               "case:=ring7_lag0.3 scenario:=ring7 lag:=0.3 time_limit:=90 expect_lag_warning:=true"
+               "case:=ring7_unicycle_lag0.1 scenario:=ring7 lag:=0.1 kinematics:=unicycle heading_seed:=3 time_limit:=90 expect_lag_warning:=true"
+               "case:=ring7_unicycle_lag0.3 scenario:=ring7 lag:=0.3 kinematics:=unicycle heading_seed:=5 time_limit:=90 expect_lag_warning:=true")
+    separate_arguments(args UNIX_COMMAND "${case}")
+    add_rostest(test/ros/robots_run.test ARGS ${args})
+  endforeach()
   # render_bag.py on a recorded hexagon: video length, frames, processes left, bad inputs.
   add_rostest(test/ros/render.test)
   # SIGKILL to the nodelet manager of every agent during a recorded run: test/ros/nodelet_fault.test.

@@ -10,10 +10,13 @@ exit status 2.
 usage: make_agents_launch.py --scenario FILE --out FILE [--rate R] [--order forward|reverse]
                              [--stagger SECONDS] [--respawn true|false] [--nodelet true|false [--nodelet-threads N (0: auto)]]
                              [--mode lockstep|timed [--delay S] [--jitter S] [--loss P] [--max-age S]
-                              [--seed N] [--respawn-delay S] [--robot true|false [--lag S] [--noise M]]]
+                              [--seed N] [--respawn-delay S] [--robot true|false [--lag S] [--noise M]
+                               [--kinematics holonomic|unicycle] [--feedback integrated|odometry]
+                               [--hand-offset M] [--heading-seed N] [--heading-noise RAD]]]
                              [--in-launch]
 With --robot true (timed mode), each agent also gets a simulated robot, robot_sim, in
-formation/robot_<id> (odom and cmd_vel there), started at the scenario's initial position.
+formation/robot_<id> (odom and cmd_vel there), started at the scenario's initial position (a
+unicycle's hand point there, at the scenario's initial_heading or one drawn from --heading-seed).
 With --nodelet true (lockstep mode), every agent is a nodelet of one manager, formation/manager
 (the agent_manager node, which loads them itself; doc/distributed.md, "Nodelets"), instead of a
 node of its own.
@@ -135,7 +138,8 @@ def timed_args(args, i):
     return (("mode", "timed"), ("respawn_delay", args.respawn_delay), ("delay", args.delay),
             ("jitter", args.jitter), ("loss", args.loss),
             ("max_age", args.max_age), ("seed", str(args.seed + i)), ("robot", args.robot)) + (
-                (("odom", f"robot_{i}/odom"), ("cmd_vel", f"robot_{i}/cmd_vel")) if args.robot == "true" else ())
+                (("kinematics", args.kinematics), ("feedback", args.feedback), ("hand_offset", args.hand_offset),
+                 ("robot_lag", args.lag)) if args.robot == "true" else ())
 
 
 def robot_sim(args, i):
@@ -143,14 +147,22 @@ def robot_sim(args, i):
     with open(args.scenario) as f:
         agent = next(a for a in yaml.safe_load(f)["agents"] if int(a["id"]) == i)
     start = ", ".join(repr(float(x)) for x in agent["initial_position"])
+    unicycle = []
+    if args.kinematics == "unicycle":
+        # The scenario's initial_heading if it has one, else robot_sim draws it from heading_seed.
+        heading = agent.get("initial_heading")
+        unicycle = [f'    <param name="kinematics" type="str" value="unicycle"/>',
+                    f'    <param name="hand_offset" type="double" value="{args.hand_offset}"/>',
+                    f'    <param name="heading_seed" type="int" value="{args.heading_seed}"/>',
+                    f'    <param name="heading_noise" type="double" value="{args.heading_noise}"/>'] + (
+            [f'    <param name="initial_heading" type="double" value="{float(heading)!r}"/>'] if heading is not None else [])
     return [f'  <node name="robot_sim" ns="formation/robot_{i}" pkg="variational_formation" type="robot_sim" '
             'output="screen">',
             f'    <param name="id" type="int" value="{i}"/>',
             f'    <rosparam param="initial_position">[{start}]</rosparam>',
             f'    <param name="lag" type="double" value="{args.lag}"/>',
             f'    <param name="odometry_noise" type="double" value="{args.noise}"/>',
-            f'    <param name="seed" type="int" value="{args.seed + i}"/>',
-            "  </node>"]
+            f'    <param name="seed" type="int" value="{args.seed + i}"/>'] + unicycle + ["  </node>"]
 
 
 def main():
@@ -172,6 +184,11 @@ def main():
     parser.add_argument("--respawn-delay", type=non_negative("respawn_delay"), default="0")
     parser.add_argument("--lag", type=non_negative("lag"), default="0.1")
     parser.add_argument("--noise", type=non_negative("noise"), default="0.01")
+    parser.add_argument("--kinematics", choices=("holonomic", "unicycle"), default="holonomic")
+    parser.add_argument("--feedback", choices=("integrated", "odometry"), default="integrated")
+    parser.add_argument("--hand-offset", type=positive("hand_offset"), default="0.1")
+    parser.add_argument("--heading-seed", type=seed, default=0)
+    parser.add_argument("--heading-noise", type=non_negative("heading_noise"), default="0.01")
     parser.add_argument("--nodelet", type=boolean("nodelet"), default="false")
     parser.add_argument("--nodelet-threads", type=non_negative_int("nodelet_threads"), default="0")
     parser.add_argument("--in-launch", action="store_true")

@@ -27,6 +27,7 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   // Frames carry the namespace, so that two formations side by side have distinct frames.
   const std::string ns = framePrefix(nh);
   frame_ = ns + name_;
+  worldFrame_ = worldFrame(pnh);
   managers_ = agentManagers(nh, pnh);
   statePub_ = nh.advertise<AgentState>(name_ + "/state", 1000, /*latch=*/true);
   for (int j : agent_->neighbourIds()) neighbourOwners_.push_back(agentNodeName(nh, j));
@@ -140,7 +141,7 @@ void AgentNode::publish() {
   const AgentStatePtr state = boost::make_shared<AgentState>();
   AgentState& msg = *state;
   msg.header.stamp.fromSec(agent_->time());
-  msg.header.frame_id = "world";
+  msg.header.frame_id = worldFrame_;
   msg.id = static_cast<uint32_t>(agent_->id());
   msg.step = agent_->step();
   msg.time = agent_->time();

@@ -15,6 +15,7 @@ namespace vf {
 
 MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh, bool timed) : nh_(nh) {
   path_ = requiredParam<std::string>(pnh, "scenario");
+  worldFrame_ = worldFrame(pnh);
   trailLength_ = optionalParam(pnh, "trail_length", 100);
   window_ = optionalParam(pnh, "window", 100);
   markerEvery_ = optionalParam(pnh, "marker_every", 1);
@@ -141,7 +142,7 @@ void MonitorNode::drop(int agent, const std::string& why) {
 
 void MonitorNode::publishProgress(const RunProgress& progress) {
   progress_ = progress;
-  progress_.header.stamp.fromSec(std::max(0L, static_cast<long>(progress.completed_step)) * scenario_.timeStep);
+  progress_.header.stamp = stampOf(progress.completed_step);
   progressPub_.publish(progress_);
 }
 
@@ -175,6 +176,7 @@ void MonitorNode::reportWaiting(const std::string& line) {
 int MonitorNode::run() {
   begin();
   lastReportAt_ = ros::WallTime::now();
+  progress_.header.stamp = stampOf(progress_.completed_step);
   progressPub_.publish(progress_);
   watchTimer_ = nh_.createWallTimer(ros::WallDuration(0.5), [this](const ros::WallTimerEvent&) {
     if (!ended()) watch();

@@ -26,6 +26,7 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
   FormationStatus& status = out.first;
   status = toStatusMessage(s);
   status.header.stamp = stamp;
+  status.header.frame_id = worldFrame_;
   status.dropped = static_cast<uint32_t>(dropped_);
   status.max_data_age = dataAge;
   if (!noetherHolds) {
@@ -48,7 +49,10 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
   const bool edge = s.metrics.step == 0 || (last > 0 && s.metrics.step == last);
   if (edge || (s.metrics.step % markerEvery_ == 0 && (recording_ || markersPub_.getNumSubscribers() > 0))) {
     out.second = makeMarkers(s, measure().formation(), trails_);
-    for (auto& m : out.second.markers) m.header.stamp = stamp;
+    for (auto& m : out.second.markers) {
+      m.header.stamp = stamp;
+      m.header.frame_id = worldFrame_;
+    }
     markersPub_.publish(out.second);
   }
   convergedStep_ = s.converged ? s.convergedStep : -1;
@@ -105,6 +109,7 @@ void MonitorNode::finish(uint8_t state, std::string reason) {
   }
   progress_.state = state;
   progress_.reason = reason;
+  progress_.header.stamp = stampOf(progress_.completed_step);
   progressPub_.publish(progress_);
 }
 

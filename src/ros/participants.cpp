@@ -100,6 +100,17 @@ std::string framePrefix(const ros::NodeHandle& nh) {
   return ns.empty() ? "" : ns + "/";
 }
 
+std::string worldFrame(const ros::NodeHandle& pnh) {
+  std::string key, frame = "world";
+  if (pnh.searchParam("world_frame", key) && !pnh.getParam(key, frame)) {
+    throw InvalidInput(key + ": expected a frame name (a string)");
+  }
+  if (frame.empty() || frame.find_first_of(" \t\n") != std::string::npos) {
+    throw InvalidInput("world_frame: expected a frame name without spaces, got '" + frame + "'");
+  }
+  return frame;
+}
+
 std::string participantName(const ros::NodeHandle& nh, const std::string& relative) {
   return nh.resolveName(relative, /*remap=*/false);
 }

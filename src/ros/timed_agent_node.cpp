@@ -6,6 +6,7 @@
 #include <geometry_msgs/Twist.h>
 #include <ros/callback_queue.h>
 
+#include "variational_formation/core/error.hpp"
 #include "variational_formation/core/number_checks.hpp"
 #include "variational_formation/core/validation.hpp"
 #include "variational_formation/ros/parameters.hpp"
@@ -53,12 +54,8 @@ TimedAgentNode::TimedAgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
       nh, agent_->neighbourIds(), 100,
       [this](int j, const ros::MessageEvent<AgentState const>& e) { onNeighbourState(j, e); },
       [this](const ros::MessageEvent<RunProgress const>& e) { onProgress(e); }, subs_, progressSub_);
-  if (robot_) {
-    // Relative names in the node's private namespace' parent: remap them to a real robot's.
-    odomSub_ = pnh.subscribe("odom", 10, &TimedAgentNode::onOdometry, this, ros::TransportHints().tcpNoDelay());
-    setpointPub_ = pnh.advertise<geometry_msgs::PoseStamped>("setpoint", 10);
-    cmdVelPub_ = pnh.advertise<geometry_msgs::Twist>("cmd_vel", 10);
-  }
+  worldFrame_ = worldFrame(pnh);
+  if (robot_) setUpRobot(nh, pnh, scenario, id);
   recallServer_ = nh.advertiseService(name_ + "/recall", &TimedAgentNode::onRecall, this);
   // The server starts from ~kappa: the scenario's (an earlier value would be another run's).
   pnh.setParam("kappa", scenario.dampingGain);
@@ -72,7 +69,11 @@ TimedAgentNode::TimedAgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
            "loss %g, seed %d, max_age %g s%s, monitor %s",
            name_.c_str(), scenario.name.c_str(), path.c_str(), static_cast<int>(agent_->neighbourIds().size()),
            scenario.dampingGain, h_, h_ / rate_, faults.delay, faults.jitter, faults.loss, seed, maxAge,
-           robot_ ? (", robot mode (odom " + odomSub_.getTopic() + ")").c_str() : "", monitor_.c_str());
+           robot_ ? (", robot mode (" + std::string(kinematicsName(link_->settings().kinematics)) + ", " +
+                     feedbackName(link_->settings().feedback) + " feedback, odom " + odomSub_.getTopic() + ")")
+                        .c_str()
+                  : "",
+           monitor_.c_str());
 }
 
 void TimedAgentNode::drop(const std::string& why) {
@@ -118,16 +119,6 @@ void TimedAgentNode::onProgress(const ros::MessageEvent<RunProgress const>& even
   }
 }
 
-void TimedAgentNode::onOdometry(const nav_msgs::Odometry& odom) {
-  const auto& p = odom.pose.pose.position;
-  const std::size_t d = agent_->position().size();
-  std::vector<double> q = {p.x, p.y, p.z};
-  q.resize(d);
-  measured_ = q;
-  if (!haveOdometry_) ROS_INFO("%s: first odometry on %s", name_.c_str(), odomSub_.getTopic().c_str());
-  haveOdometry_ = true;
-}
-
 void TimedAgentNode::onTick() {
   diagnostics_.update();  // rate-limited by the updater itself (~diagnostic_period, 1 s)
   const double t = now();
@@ -145,7 +136,7 @@ void TimedAgentNode::onTick() {
       drop(std::string("a state: ") + e.what());
     }
   }
-  if (robot_ && !haveOdometry_) {
+  if (robot_ && !link_->measured()) {
     ROS_WARN_THROTTLE(kReportEvery, "%s: holding: no odometry on %s yet", name_.c_str(), odomSub_.getTopic().c_str());
     return;
   }
@@ -155,7 +146,10 @@ void TimedAgentNode::onTick() {
     publish();
   }
   if (!running_ || agent_->finished()) return;
-  if (robot_) agent_->setMeasuredPosition(measured_);
+  if (robot_) {
+    link_->startPosition(agent_->position(), start_);
+    agent_->setMeasuredPosition(start_);
+  }
   const TimedAgent::TickResult result = agent_->tick(t);
   if (result.holding) {
     std::string who;
@@ -186,7 +180,7 @@ void TimedAgentNode::onTick() {
     }
   }
   publish();
-  if (robot_ && agent_->finished()) cmdVelPub_.publish(geometry_msgs::Twist());  // our last step: stop the robot
+  if (robot_) sendCommand();
 }
 
 void TimedAgentNode::reportWaiting() {

@@ -17,7 +17,7 @@ void TimedAgentNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "run over");
   } else if (!running_) {
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "waiting for the monitor to start the run");
-  } else if (robot_ && !haveOdometry_) {
+  } else if (robot_ && !link_->measured()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "holding: no odometry yet");
   } else if (agent_->holding()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "holding: a neighbour is silent");
@@ -33,6 +33,20 @@ void TimedAgentNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
   status.add("states refused (outdated or malformed)", agent_->dropped());
   status.add("states dropped (not from the owner)", dropped_);
   status.add("kappa [1/s]", agent_->dampingGain());
+  if (robot_) {
+    status.add("kinematics", kinematicsName(link_->settings().kinematics));
+    status.add("feedback", feedbackName(link_->settings().feedback));
+    status.add("cmd_vel sent", link_->commands());
+    status.add("cmd_vel saturated (scaled down to max_speed, max_turn_rate)", link_->saturatedCommands());
+    status.add("odometry dropped (malformed)", badOdometry_);
+    status.add("robot lag + tick [s]", lagCheck_.lagPlusTick);
+    status.add("delay margin [s]", lagCheck_.capped ? -1.0 : lagCheck_.marginSeconds);  // -1: none found
+    status.add("lag exceeds the delay margin", lagCheck_.exceeded);
+    if (link_->settings().kinematics == RobotKinematics::Unicycle) status.add("heading [rad]", link_->heading());
+    if (link_->saturatedCommands() > 0 && status.level == diagnostic_msgs::DiagnosticStatus::OK) {
+      status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, "cmd_vel saturated at the limits");
+    }
+  }
   for (const TimedAgent::NeighbourStatus& n : agent_->neighbourStatus(t)) {
     const std::string who = "agent_" + std::to_string(n.id);
     status.add(who + " age [s]", n.heard ? n.age : -1.0);
@@ -54,8 +68,8 @@ void TimedAgentNode::onReconfigure(variational_formation::TimedAgentConfig& conf
 
 void TimedAgentNode::publish() {
   AgentState msg;
-  msg.header.stamp.fromSec(agent_->step() * h_);  // the simulated time of the step
-  msg.header.frame_id = "world";
+  msg.header.stamp = ros::Time::now();  // ROS time, as robots and tf consumers expect (msg.time: simulated)
+  msg.header.frame_id = worldFrame_;
   msg.id = static_cast<uint32_t>(agent_->id());
   msg.step = agent_->step();
   msg.time = agent_->step() * h_;
@@ -75,15 +89,7 @@ void TimedAgentNode::publish() {
 
   tf_.sendTransform(frameAt(msg.header, frame_, msg.position));
 
-  if (robot_) {
-    setpointPub_.publish(pose);
-    geometry_msgs::Twist cmd;
-    const std::vector<double>& v = agent_->commandedVelocity();
-    cmd.linear.x = v[0];
-    cmd.linear.y = v[1];
-    cmd.linear.z = v.size() > 2 ? v[2] : 0.0;
-    cmdVelPub_.publish(cmd);
-  }
+  if (robot_) setpointPub_.publish(pose);
 }
 
 }  // namespace vf

@@ -38,9 +38,7 @@ void TimedMonitor::tick() {
   const std::vector<FormationSnapshot> done = referee_->tick(ros::WallTime::now().toSec());
   if (done.empty()) return;  // not every agent is there yet: the run has not started
   for (const FormationSnapshot& s : done) {
-    ros::Time stamp;
-    stamp.fromSec(s.metrics.time);  // the monitor's own step (its tick) times h
-    publishSnapshot(s, stamp, referee_->dataAge(), false);
+    publishSnapshot(s, stampOf(s.metrics.step), referee_->dataAge(), false);
   }
   // The progress starts the agents at the first tick (start by identity, as in lockstep); after
   // that they ignore the window, and it says every quarter window how far the run is.

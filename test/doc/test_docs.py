@@ -189,6 +189,18 @@ def enclosing_function(tokens, before, variable):
     return None
 
 
+def searched_name(tokens, paren, word):
+    """The literal name of an earlier searchParam("name", word), whose result `word` a read at
+    `paren` uses (the parameter found upwards from a namespace), or None."""
+    for k in range(paren - 1, max(-1, paren - 400), -1):
+        if tokens[k].text == "searchParam" and tokens[k + 1].text == "(":
+            args = split_arguments(tokens, k + 2, closing(tokens, k + 1, "(", ")"))
+            if (len(args) == 2 and len(args[1]) == 1 and args[1][0].text == word and len(args[0]) == 1
+                    and args[0][0].kind == "string"):
+                return args[0][0].literal()
+    return None
+
+
 def cpp_reads(files, problems):
     """Every parameter read in the C++ files; problems gets each read it cannot tell."""
     parsed = {path: cpp_tokens(read(path)) for path in files}
@@ -226,6 +238,8 @@ def cpp_reads(files, problems):
                 names = loop_names(tokens, paren, arg[0].text)
                 if names is not None:
                     reads += [Read(n.lstrip("~"), where) for n in names]
+                elif searched_name(tokens, paren, arg[0].text) is not None:
+                    continue  # the searchParam before it is the read, and is counted
                 elif enclosing_function(tokens, paren, arg[0].text) is None:
                     problems.append(f"{where}: {reader}({arg[0].text}, ...): cannot tell which parameter it reads")
             elif not is_declaration(arg):

@@ -1,10 +1,23 @@
 #!/usr/bin/python3
-"""rostest (robots_run.test): simulated robots (lag 0.1 s, odometry noise 1 cm) driven by
-time-driven agents in robot mode form the hexagon.
+"""rostest (robots_run.test): simulated robots (1 cm odometry noise) driven by time-driven agents in
+robot mode form the shape, checked from the robots' own odometry in the recorded bag, not from the
+agents' states.
 
-Checked independently of the agents' own states: from the robots' odometry in the bag, averaged
-over the last second (the noise is white, 1 cm), every edge's length is within 1 cm of the
-desired one; and the bag holds every robot's nav_msgs/Odometry throughout the run.
+- The run succeeds and the monitor says the formation converged.
+- The robots' points (a unicycle's hand point, hand_offset ahead of the axle at the odometry
+  heading), averaged over the run's last second, are congruent with the desired shape: every
+  pair's distance within 1 cm of the desired one.
+- The bag holds every robot's odometry and cmd_vel throughout (recording in timed mode).
+- Every stamp in the bag (headers, tf and markers) is within 1 s of the time it was recorded at:
+  robots' topics are in ROS time. The first message of a topic may be a latched one, published
+  before rosbag subscribed: it may be older, but by less than 30 s (not from 1970).
+- Frames: every stamped message and transform is in the world frame (the case's world_frame),
+  and a robot's frame is formation/robot_<i>/base_link (its namespace once).
+- Unicycles: every cmd_vel has linear.y = linear.z = 0, and every robot really turned. Holonomic
+  robots: no cmd_vel turns, and base_link keeps the world's axes.
+- Every agent compares its robot's lag plus one tick with the scenario's delay margin and reports
+  both numbers in its diagnostics; the case says whether the lag exceeds the margin (ring7's
+  margin is 0.05 s, the hexagon's wider than 0.114 s).
 """
 import math
 import os
@@ -17,11 +30,22 @@ import unittest
 import rosbag
 import rospy
 import rostest
+from diagnostic_msgs.msg import DiagnosticArray
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import vf_rostest  # noqa: E402
 
-TOLERANCE = 0.01  # [m] on every edge length, from the robots' averaged odometry
+TOLERANCE = 0.01  # [m] on every pair distance, from the robots' averaged odometry
+STAMP_TOLERANCE = 1.0  # [s] between a stamp and the time the bag received it
+LATCHED_AGE = 30.0  # [s] a topic's first message may be this much older (latched before rosbag came)
+
+
+def yaw(q):
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def wrapped(angle):
+    return math.atan2(math.sin(angle), math.cos(angle))
 
 
 @vf_rostest.reported_setup
@@ -29,64 +53,172 @@ class RobotsRun(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         rospy.init_node("robots_run_test")
+        cls.diagnostics = {}  # hardware id -> the newest status's values
+        cls.diagnostics_sub = rospy.Subscriber("/diagnostics", DiagnosticArray, cls.on_diagnostics, queue_size=100)
         cls.path = rospy.get_param("~scenario")
         cls.out = rospy.get_param("~output_dir")
+        cls.kinematics = rospy.get_param("~kinematics")
+        cls.hand_offset = float(rospy.get_param("~hand_offset"))
+        cls.lag = float(rospy.get_param("~lag"))
+        cls.expect_lag_warning = rospy.get_param("~expect_lag_warning")
+        cls.world_frame = rospy.get_param("~world_frame")
+        cls.frames = set()  # (parent, child) of every transform; (frame, topic) of every other header
         cls.scenario = vf_rostest.load_scenario(cls.path)
         name = os.path.basename(cls.path).replace(".yaml", "")
-        cls.result = vf_rostest.wait_for_result(os.path.join(cls.out, name + ".result.yaml"), 50.0)
-        # Stop the recorder (SIGINT via rosnode kill) so that the bag is closed and indexed.
-        subprocess.run(["rosnode", "kill", "/robots_bag"], capture_output=True)
-        bag = os.path.join(cls.out, name + "_robots.bag")
-        end = time.time() + 10
+        steps, h = cls.scenario["steps"], cls.scenario["time_step"]
+        cls.result = vf_rostest.wait_for_result(os.path.join(cls.out, name + ".result.yaml"), steps * h + 30.0)
+        # Stop the recorder (rosnode kill: a clean shutdown) so that the bag is closed and indexed.
+        subprocess.run(["rosnode", "kill", "/formation/recorder"], capture_output=True)
+        bag = os.path.join(cls.out, name + ".bag")
+        end = time.time() + 15
         while not os.path.exists(bag) and time.time() < end:
             time.sleep(0.2)
-        cls.odom = {}
-        cls.status = []
+        cls.odom, cls.cmd_vel, cls.status = {}, {}, []
+        cls.stamps = 0
+        cls.worst_stamp = (0.0, "")
+        cls.worst_first = (0.0, "")
+        cls.seen = set()
         with rosbag.Bag(bag) as b:
             for topic, msg, t in b.read_messages():
+                cls.check_stamps(topic, msg, t)
                 if topic.endswith("/odom"):
                     cls.odom.setdefault(topic, []).append((t.to_sec(), msg))
-                elif topic.endswith("/status"):
+                elif topic.endswith("/cmd_vel"):
+                    cls.cmd_vel.setdefault(topic, []).append(msg)
+                elif topic == "/formation/status":
                     cls.status.append((t.to_sec(), msg))
 
     @classmethod
+    def on_diagnostics(cls, msg):
+        for s in msg.status:
+            if s.hardware_id.startswith("formation/agent_"):
+                cls.diagnostics[s.hardware_id] = {kv.key: kv.value for kv in s.values}
+
+    @classmethod
+    def check_stamps(cls, topic, msg, t):
+        headers = [msg.header] if hasattr(msg, "header") else []
+        headers += [tf.header for tf in getattr(msg, "transforms", [])]
+        headers += [m.header for m in getattr(msg, "markers", [])]
+        for tf in getattr(msg, "transforms", []):
+            cls.frames.add((tf.header.frame_id, tf.child_frame_id))
+        for header in ([msg.header] if hasattr(msg, "header") else []) + [m.header for m in getattr(msg, "markers", [])]:
+            if header.frame_id:
+                cls.frames.add((header.frame_id, topic.rsplit("/", 1)[-1]))
+        first = topic not in cls.seen
+        cls.seen.add(topic)
+        for header in headers:
+            cls.stamps += 1
+            late = (t - header.stamp).to_sec()  # > 0: the stamp is older than the record time
+            if first and 0.0 <= late < LATCHED_AGE:
+                cls.worst_first = max(cls.worst_first, (late, topic))
+                continue
+            if abs(late) > cls.worst_stamp[0]:
+                cls.worst_stamp = (abs(late), topic)
+
+    @classmethod
     def tearDownClass(cls):
+        cls.diagnostics_sub.unregister()
         shutil.rmtree(cls.out, ignore_errors=True)
 
-    def test_run_ends(self):
-        self.assertEqual(self.result.get("result"), "succeeded", f"result file: {self.result}")
+    def n(self):
+        return self.scenario["n"]
 
-    def test_bag_holds_every_robots_odometry(self):
-        n = self.scenario["n"]
+    def test_run_ends_converged(self):
+        self.assertEqual(self.result.get("result"), "succeeded", f"result file: {self.result}")
+        self.assertGreaterEqual(int(self.result.get("converged_step", -1)), 0, f"result file: {self.result}")
+
+    def test_bag_holds_every_robots_odometry_and_commands(self):
+        n = self.n()
         self.assertEqual(sorted(self.odom), sorted(f"/formation/robot_{i}/odom" for i in range(n)))
+        self.assertEqual(sorted(self.cmd_vel), sorted(f"/formation/robot_{i}/cmd_vel" for i in range(n)))
         for topic, msgs in self.odom.items():
             span = msgs[-1][0] - msgs[0][0]
-            self.assertGreater(span, 10.0, topic)
+            self.assertGreater(span, 0.5 * self.scenario["steps"] * self.scenario["time_step"], topic)
             self.assertGreater(len(msgs), 50 * span, f"{topic}: {len(msgs)} messages in {span:.1f} s")  # 100 Hz
 
-    def edge_error(self, t0, t1):
-        """Worst |edge length - desired| [m] from each robot's odometry averaged over [t0, t1)."""
+    def test_stamps_are_ros_time(self):
+        print(f"stamps: {self.stamps} checked, worst {self.worst_stamp[0]:.3f} s from its record time "
+              f"({self.worst_stamp[1]}); first (latched) messages up to {self.worst_first[0]:.3f} s older "
+              f"({self.worst_first[1]})", flush=True)
+        self.assertGreater(self.stamps, 1000)
+        self.assertLess(self.worst_stamp[0], STAMP_TOLERANCE, self.worst_stamp[1])
+
+    def point(self, msg):
+        """The robot's controlled point from an odometry message: the hand point of a unicycle."""
+        p = msg.pose.pose.position
+        if self.kinematics != "unicycle":
+            return p.x, p.y
+        theta = yaw(msg.pose.pose.orientation)
+        return p.x + self.hand_offset * math.cos(theta), p.y + self.hand_offset * math.sin(theta)
+
+    def pair_error(self, t0, t1):
+        """Worst | |p_i - p_j| - |q*_i - q*_j| | [m] over all pairs, points averaged over [t0, t1)."""
         mean = []
-        for i in range(self.scenario["n"]):
-            window = [m.pose.pose.position for t, m in self.odom[f"/formation/robot_{i}/odom"] if t0 <= t < t1]
-            mean.append((sum(p.x for p in window) / len(window), sum(p.y for p in window) / len(window)))
+        for i in range(self.n()):
+            window = [self.point(m) for t, m in self.odom[f"/formation/robot_{i}/odom"] if t0 <= t < t1]
+            self.assertTrue(window, f"robot_{i}: no odometry in [{t0:.1f}, {t1:.1f})")
+            mean.append((sum(p[0] for p in window) / len(window), sum(p[1] for p in window) / len(window)))
         desired = [a["desired_position"] for a in sorted(self.scenario["agents"], key=lambda a: a["id"])]
-        return max(abs(math.dist(mean[a], mean[b]) - math.dist(desired[a], desired[b])) for a, b in self.scenario["edges"])
+        return max(abs(math.dist(mean[a], mean[b]) - math.dist(desired[a], desired[b]))
+                   for a in range(self.n()) for b in range(a + 1, self.n()))
 
     def test_robots_form_the_shape(self):
-        start = min(msgs[0][0] for msgs in self.odom.values())
-        end = min(msgs[-1][0] for msgs in self.odom.values())
         self.assertTrue(self.status, "no status in the bag")
-        profile = [self.edge_error(t, t + 1.0) for t in range(int(start), int(end))]
-        print("robots: worst edge error per second [m]: " + " ".join(f"{e:.3f}" for e in profile), flush=True)
-        # The last second of the run: up to the monitor's last status.
-        end = self.status[-1][0]
-        worst = self.edge_error(end - 1.0, end)
-        print(f"robots: worst edge error {worst:.4f} m from the odometry of the run's last second", flush=True)
+        start = min(msgs[0][0] for msgs in self.odom.values())
+        end = self.status[-1][0]  # the monitor's last status: the end of the run
+        profile = [self.pair_error(t, t + 1.0) for t in range(int(start), int(end) - 1)]
+        print("robots: worst pair distance error per second [m]: " + " ".join(f"{e:.3f}" for e in profile),
+              flush=True)
+        formed = next((k for k in range(len(profile)) if all(e < TOLERANCE for e in profile[k:])), None)
+        worst = self.pair_error(end - 1.0, end)
+        print(f"robots ({self.kinematics}, lag {self.lag} s): worst pair distance error {worst * 1000:.2f} mm over "
+              f"the run's last second; within {TOLERANCE * 100:.0f} cm from second "
+              f"{formed if formed is not None else 'never'} of the run", flush=True)
         self.assertLess(worst, TOLERANCE)
-        last = self.status[-1][1]
-        print(f"monitor: last status tick {last.step}, max distance error {last.max_distance_error:.4f} m "
-              f"(from the agents' setpoints), congruent {last.converged}", flush=True)
+
+    def test_frames(self):
+        parents = {parent for parent, _ in self.frames}
+        self.assertEqual(parents, {self.world_frame}, sorted(self.frames))
+        children = {child for _, child in self.frames}
+        for i in range(self.n()):
+            self.assertIn(f"formation/robot_{i}/base_link", children)
+            self.assertIn(f"formation/agent_{i}", children)
+        for topic, msgs in self.odom.items():
+            self.assertEqual({m.child_frame_id for _, m in msgs}, {topic.replace("/odom", "/base_link")[1:]})
+
+    def test_commands_suit_the_kinematics(self):
+        msgs = [m for v in self.cmd_vel.values() for m in v]
+        self.assertTrue(msgs)
+        if self.kinematics == "unicycle":
+            self.assertEqual(max(abs(m.linear.y) + abs(m.linear.z) for m in msgs), 0.0)
+            self.assertGreater(max(abs(m.angular.z) for m in msgs), 0.0)
+        else:
+            self.assertEqual(max(abs(m.angular.x) + abs(m.angular.y) + abs(m.angular.z) for m in msgs), 0.0)
+
+    def test_unicycles_really_turned(self):
+        if self.kinematics != "unicycle":
+            # A point robot's base_link keeps the world's axes.
+            self.assertEqual({yaw(m.pose.pose.orientation) for v in self.odom.values() for _, m in v}, {0.0})
+            return
+        for i in range(self.n()):
+            headings = [yaw(m.pose.pose.orientation) for _, m in self.odom[f"/formation/robot_{i}/odom"]]
+            turned = max(abs(wrapped(h - headings[0])) for h in headings)
+            print(f"robot_{i}: heading {headings[0]:+.3f} rad at start, turned up to {turned:.3f} rad", flush=True)
+            self.assertGreater(turned, 0.1, f"robot_{i} did not turn")
+
+    def test_agents_compare_the_lag_with_the_delay_margin(self):
+        agents = {f"formation/agent_{i}" for i in range(self.n())}
+        self.assertEqual(set(self.diagnostics), agents, "every agent's diagnostics")
+        tick = self.scenario["time_step"]  # rate 1
+        for agent, values in sorted(self.diagnostics.items()):
+            lag_plus_tick = float(values["robot lag + tick [s]"])
+            margin = float(values["delay margin [s]"])
+            exceeds = values["lag exceeds the delay margin"] == "True"
+            print(f"{agent}: robot lag + tick {lag_plus_tick:.3f} s, delay margin {margin:.3f} s, exceeded {exceeds}",
+                  flush=True)
+            self.assertAlmostEqual(lag_plus_tick, self.lag + tick, places=9)
+            self.assertEqual(exceeds, margin >= 0 and lag_plus_tick > margin, values)
+            self.assertEqual(exceeds, self.expect_lag_warning, values)
 
 
 if __name__ == "__main__":

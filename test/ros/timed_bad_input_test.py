@@ -1,7 +1,10 @@
 #!/usr/bin/python3
-"""rostest (timed_bad_input.test): a timed agent with a bad parameter, and make_agents_launch.py
-with a bad timed argument, each end with exit status 2 and one line on stderr naming the field
-and the value."""
+"""rostest (timed_bad_input.test): a timed agent or robot_sim with a bad parameter, and
+make_agents_launch.py with a bad timed or robot argument, each end with exit status 2 and one line
+on stderr naming the field and the value. Odometry that is not a pose (a NaN, a quaternion that is
+not a rotation), sent by this test's own node, is dropped, counted and warned about by a
+robot-mode agent, which stays up."""
+import contextlib
 import os
 import signal
 import subprocess
@@ -12,12 +15,31 @@ import unittest
 import rospkg
 import rospy
 import rostest
+from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Log
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import vf_rostest  # noqa: E402
 
 HEXAGON = vf_rostest.scenario_path("hexagon")
+
+
+@contextlib.contextmanager
+def robot_agent(ns, *params):
+    """A robot-mode timed agent agent_0 in `ns` while the block runs; yields (process, its /rosout
+    lines). On leaving: SIGINT, and the agent must end."""
+    lines = []
+    sub = rospy.Subscriber("/rosout", Log, lambda m: lines.append(m) if m.name == f"{ns}/agent_0" else None,
+                           queue_size=1000)
+    p = subprocess.Popen(["rosrun", vf_rostest.PKG, "agent", "__name:=agent_0", f"__ns:={ns}", "_id:=0",
+                          f"_scenario:={HEXAGON}", "_mode:=timed", "_real_time_factor:=1", "_robot:=true"] +
+                         list(params), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        yield p, lines
+    finally:
+        p.send_signal(signal.SIGINT)
+        p.wait(timeout=20)
+        sub.unregister()
 
 
 def run(command):
@@ -67,22 +89,67 @@ class TimedBadInput(unittest.TestCase):
         self.check(run(base + ["--loss", "-0.2"]), "loss", "-0.2")
         self.check(run(base[:-2] + ["--rate", "0"]), "rate", "timed")
 
+    def test_negative_hand_offset(self):
+        self.check(self.agent("agent_hand", robot="true", kinematics="unicycle", hand_offset="-0.1"),
+                   "hand_offset", "-0.1")
+
+    def test_unknown_kinematics(self):
+        self.check(self.agent("agent_tank", robot="true", kinematics="tank"), "kinematics", "tank")
+
+    def test_unicycle_needs_the_plane(self):
+        self.check(self.agent("agent_3d", robot="true", kinematics="unicycle",
+                              scenario=vf_rostest.scenario_path("tetrahedron")), "kinematics", "plane")
+
+    def test_robot_sim_bad_parameters(self):
+        # A list cannot be given as _param:= to a C++ node.
+        for name in ("sim_tank", "sim_hand"):
+            rospy.set_param(f"/bad/robot_0/{name}/initial_position", [0.0, 0.0])
+        base = ["rosrun", vf_rostest.PKG, "robot_sim", "__ns:=/bad/robot_0", "_id:=0"]
+        self.check(run(base + ["__name:=sim_tank", "_kinematics:=tank"]), "kinematics", "tank")
+        self.check(run(base + ["__name:=sim_hand", "_kinematics:=unicycle", "_hand_offset:=-0.2"]), "hand_offset",
+                   "-0.2")
+
+    def test_robot_launch_arguments(self):
+        base = [self.script, "--scenario", HEXAGON, "--out", "/dev/null", "--mode", "timed", "--rate", "1",
+                "--robot", "true"]
+        self.check(run(base + ["--kinematics", "tank"]), "kinematics", "tank")
+        self.check(run(base + ["--hand-offset", "-0.1"]), "hand_offset", "-0.1")
+        self.check(run(base + ["--feedback", "gps"]), "feedback", "gps")
+
+    def test_malformed_odometry_is_dropped_counted_and_warned(self):
+        pub = rospy.Publisher("/odd_robot/odom", Odometry, queue_size=10)
+        with robot_agent("/odd", "_kinematics:=unicycle", "_robot_namespace:=/odd_robot") as (p, lines):
+            end = time.time() + 20
+            while pub.get_num_connections() == 0 and time.time() < end:
+                time.sleep(0.1)
+            self.assertEqual(pub.get_num_connections(), 1, "the agent never subscribed to /odd_robot/odom")
+            nan = Odometry()
+            nan.pose.pose.position.x = float("nan")
+            nan.pose.pose.orientation.w = 1.0
+            squashed = Odometry()  # quaternion of norm 0.5: not a rotation
+            squashed.pose.pose.orientation.w = 0.5
+            for _ in range(3):
+                pub.publish(nan)
+                time.sleep(1.1)  # the warning is throttled to one a second
+                pub.publish(squashed)
+                time.sleep(1.1)
+            time.sleep(6.0)  # until it says again that it holds without odometry
+            self.assertIsNone(p.poll(), "the agent ended on malformed odometry")
+        dropped = [m.msg for m in lines if "dropped an odometry message" in m.msg]
+        self.assertTrue(any("must be finite" in m for m in dropped), dropped)
+        self.assertTrue(any("norm 1" in m for m in dropped), dropped)
+        self.assertTrue(any(m.endswith("6 dropped so far") for m in dropped), dropped)
+        # Nothing was taken for a pose: it still holds for want of odometry.
+        self.assertTrue(any("no odometry on /odd_robot/odom" in m.msg for m in lines[-20:]),
+                        [m.msg for m in lines])
+        self.assertFalse(any("first odometry" in m.msg for m in lines), [m.msg for m in lines])
+
     def test_missing_odometry_holds_and_says_so(self):
         # A robot-mode agent whose odom topic has no publisher: it stays up, holds, and says so
         # every few seconds (no monitor either: it would not start anyway).
-        lines = []
-        sub = rospy.Subscriber("/rosout", Log, lambda m: lines.append(m) if m.name == "/lonely/agent_0" else None,
-                               queue_size=1000)
-        p = subprocess.Popen(["rosrun", vf_rostest.PKG, "agent", "__name:=agent_0", "__ns:=/lonely", "_id:=0",
-                              f"_scenario:={HEXAGON}", "_mode:=timed", "_real_time_factor:=1", "_robot:=true",
-                              "~odom:=/nobody/odom"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        try:
+        with robot_agent("/lonely", "_robot_namespace:=/nobody") as (p, lines):
             time.sleep(12.0)
             self.assertIsNone(p.poll(), "the agent ended without odometry")
-        finally:
-            p.send_signal(signal.SIGINT)
-            p.wait(timeout=20)
-            sub.unregister()
         said = [m.msg for m in lines if "no odometry on /nobody/odom" in m.msg]
         self.assertTrue(2 <= len(said) <= 4, f"{len(said)} lines: {[m.msg for m in lines]}")
 

@@ -99,7 +99,7 @@ class AgentNode {
   ros::WallTime startedAt_, lastStepAt_, lastReportAt_;
   long dropped_ = 0;
   int exitStatus_ = -1;  // -1: running
-  std::string name_, frame_, failure_;
+  std::string name_, frame_, failure_, worldFrame_;
 };
 
 }  // namespace vf

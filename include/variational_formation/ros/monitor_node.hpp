@@ -67,6 +67,9 @@ class MonitorNode {
   virtual std::string waitingFor() const = 0;
   virtual long completedStep() const = 0;
   virtual const FormationMonitor& measure() const = 0;
+  /// The stamp of what the monitor says about `step`: its simulated time in lockstep (replay and
+  /// /clock need it), ROS time now in timed mode (robots and tf consumers live in it).
+  virtual ros::Time stampOf(long step) const = 0;
 
   /// Publishes one completed step's status and markers (and /clock), stamped `stamp`; tracks the
   /// congruent stretch for the result. @return what was published, for the recorder gate.
@@ -86,7 +89,7 @@ class MonitorNode {
   }
 
   ros::NodeHandle nh_;
-  std::string path_;
+  std::string path_, worldFrame_;
   Scenario scenario_;
   std::string recorderParam_;  // ~recorder, relative
   bool recording_ = false;     // a recorder takes part (lockstep)
@@ -142,6 +145,7 @@ class LockstepMonitor : public MonitorNode {
   std::string waitingFor() const override { return referee_->waitingFor(recorder_.node); }
   long completedStep() const override { return referee_->completedStep(); }
   const FormationMonitor& measure() const override { return referee_->monitor(); }
+  ros::Time stampOf(long step) const override { return ros::Time(std::max(0L, step) * scenario_.timeStep); }
   void onRecorderProgress(const ros::MessageEvent<RunProgress const>& event);
   bool onRecall(RecallState::Request& request, RecallState::Response& response);
   bool onHistory(RecallHistory::Request& request, RecallHistory::Response& response);
@@ -176,6 +180,7 @@ class TimedMonitor : public MonitorNode {
   std::string waitingFor() const override;
   long completedStep() const override { return referee_->completedStep(); }
   const FormationMonitor& measure() const override { return referee_->monitor(); }
+  ros::Time stampOf(long) const override { return ros::Time::now(); }
   void tick();
 
   std::unique_ptr<protocol::TimedReferee<AgentState>> referee_;

@@ -16,6 +16,7 @@
 #include "variational_formation/RunProgress.h"
 #include "variational_formation/TimedAgentConfig.h"
 #include "variational_formation/core/link_faults.hpp"
+#include "variational_formation/core/robot_link.hpp"
 #include "variational_formation/core/timed_agent.hpp"
 
 namespace vf {
@@ -34,9 +35,13 @@ using variational_formation::RunProgress;
  * the flow-control window afterwards. A respawned agent asks its neighbours and the monitor for
  * its newest state (`~recall`, as in lockstep) and restarts from it at rest.
  *
- * Robot mode (~robot true): the position comes from `odom` (nav_msgs/Odometry); the agent holds
- * until the first odometry, and sends the setpoint on `setpoint` (PoseStamped) and the commanded
- * velocity on `cmd_vel` (Twist). Topic names are relative: remap them to a real robot's.
+ * Robot mode (~robot true, doc/robots.md): the agent reads its robot's `odom` (nav_msgs/Odometry)
+ * and sends it `cmd_vel` (Twist) and `setpoint` (PoseStamped), public topics in the robot's
+ * namespace ~robot_namespace (default robot_<id>, relative, so remappable like any driver's). The
+ * maths of the link (holonomic or unicycle hand point, odometry or integrated feedback) is
+ * RobotLink's. It holds until the first odometry; refused odometry (NaN, a quaternion that is not
+ * a rotation) is dropped, counted and warned about. At start it compares the robot's lag plus
+ * one tick with the scenario's delay margin and warns if the lag exceeds it.
  *
  * Diagnostics on /diagnostics (diagnostic_updater, about 1 Hz): step rate, each neighbour's age,
  * accepted and dropped states, injected losses, held ticks; WARN while holding.
@@ -63,6 +68,8 @@ class TimedAgentNode {
   void onOdometry(const nav_msgs::Odometry& odom);
   void onTick();
   void publish();
+  void sendCommand();
+  void setUpRobot(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Scenario& scenario, int id);
   void reportWaiting();
   void drop(const std::string& why);
   void recover();
@@ -86,8 +93,10 @@ class TimedAgentNode {
   double rate_ = 0.0;
   double h_ = 0.0;
   bool robot_ = false;
-  bool haveOdometry_ = false;
-  std::vector<double> measured_;
+  std::unique_ptr<RobotLink> link_;  // robot mode only
+  std::vector<double> start_;         // the position the next tick starts from (robot mode)
+  long badOdometry_ = 0;
+  RobotLagCheck lagCheck_;
   bool running_ = false;
   long dropped_ = 0;
   int exitStatus_ = -1;  // -1: running
@@ -96,7 +105,7 @@ class TimedAgentNode {
   long diagnosedStep_ = 0;
   double diagnosedAt_ = 0.0;
   std::unique_ptr<dynamic_reconfigure::Server<variational_formation::TimedAgentConfig>> reconfigure_;
-  std::string name_, frame_;
+  std::string name_, frame_, worldFrame_;
 };
 
 }  // namespace vf
