@@ -32,6 +32,7 @@ add_library(variational_formation_core
   src/core/tracking.cpp
   src/core/run_outcome.cpp
   src/core/protocol/recovery.cpp
+  src/core/protocol/command_desk.cpp
 )
 target_include_directories(variational_formation_core PUBLIC
   $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/include>)

@@ -1,5 +1,5 @@
 # The ROS layer: thin nodes over the core, plus rostests.
-add_library(variational_formation_ros src/ros/agent_node.cpp src/ros/markers.cpp src/ros/monitor_node.cpp
+add_library(variational_formation_ros src/ros/agent_node.cpp src/ros/agent_commands.cpp src/ros/markers.cpp src/ros/monitor_node.cpp
   src/ros/output_files.cpp
   src/ros/participants.cpp
   src/ros/recorder_node.cpp)
@@ -7,8 +7,9 @@ add_library(variational_formation_ros src/ros/agent_node.cpp src/ros/markers.cpp
 target_sources(variational_formation_ros PRIVATE src/ros/timed_agent_node.cpp src/ros/timed_agent_outputs.cpp
   src/ros/timed_agent_robot.cpp)
 # The monitor's two modes over its shared wiring, and the bounded pool of service calls.
-target_sources(variational_formation_ros PRIVATE src/ros/lockstep_monitor.cpp src/ros/timed_monitor.cpp src/ros/monitor_outputs.cpp
-  src/ros/recorder_bag.cpp
+target_sources(variational_formation_ros PRIVATE src/ros/lockstep_monitor.cpp src/ros/monitor_commands.cpp
+  src/ros/timed_monitor.cpp src/ros/monitor_outputs.cpp
+  src/ros/recorder_bag.cpp src/ros/recorder_commands.cpp
   src/ros/service_call.cpp src/ros/state_batch.cpp)
 add_dependencies(variational_formation_ros ${PROJECT_NAME}_gencfg)
 # catkin's include path is given to each ROS target privately (never exported: catkin_lint).
@@ -43,6 +44,8 @@ if(CATKIN_ENABLE_TESTING)
     "scenario:=square"
     "scenario:=grid24"
     "scenario:=free_particle expect:=free_particle"
+    # The scenario's own manoeuvre, with no command topic.
+    "scenario:=hexagon_manoeuvre expect:=manoeuvre"
     "scenario:=hexagon order:=reverse stagger:=1"
     "scenario:=hexagon rate:=1 inject:=true"
     "scenario:=hexagon nodelet:=true inject:=true rate:=1"
@@ -72,6 +75,10 @@ if(CATKIN_ENABLE_TESTING)
     add_rostest(test/ros/timed_run.test ARGS ${args})
   endforeach()
   add_rostest(test/ros/timed_bad_input.test)
+  # Live commands in a recorded lockstep run (test/ros/manoeuvre_run.test): with bad ones; with
+  # an agent and the monitor killed during the manoeuvre.
+  add_rostest(test/ros/manoeuvre_run.test ARGS case:=live seed:=3)
+  add_rostest(test/ros/manoeuvre_run.test ARGS case:=faults seed:=5 faults:=true)
   # The bounded pool of service calls (no master).
   catkin_add_gtest(test_call_pool test/ros/test_call_pool.cpp)
   target_include_directories(test_call_pool SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
@@ -81,10 +88,10 @@ if(CATKIN_ENABLE_TESTING)
   # unicycles from seeded headings; ring7 (delay margin 0.05 s) with lags 0.1 and 0.3 s.
   foreach(case "case:=hexagon"
                "case:=hexagon_unicycle kinematics:=unicycle heading_seed:=7 world_frame:=map"
-               "case:=ring7_lag0.1 scenario:=ring7 lag:=0.1 time_limit:=90 expect_lag_warning:=true"
-               "case:=ring7_lag0.3 scenario:=ring7 lag:=0.3 time_limit:=90 expect_lag_warning:=true"
-               "case:=ring7_unicycle_lag0.1 scenario:=ring7 lag:=0.1 kinematics:=unicycle heading_seed:=3 time_limit:=90 expect_lag_warning:=true"
-               "case:=ring7_unicycle_lag0.3 scenario:=ring7 lag:=0.3 kinematics:=unicycle heading_seed:=5 time_limit:=90 expect_lag_warning:=true")
+               "case:=ring7_lag01 scenario:=ring7 lag:=0.1 time_limit:=90 expect_lag_warning:=true"
+               "case:=ring7_lag03 scenario:=ring7 lag:=0.3 time_limit:=90 expect_lag_warning:=true"
+               "case:=ring7_unicycle_lag01 scenario:=ring7 lag:=0.1 kinematics:=unicycle heading_seed:=3 time_limit:=90 expect_lag_warning:=true"
+               "case:=ring7_unicycle_lag03 scenario:=ring7 lag:=0.3 kinematics:=unicycle heading_seed:=5 time_limit:=90 expect_lag_warning:=true")
     separate_arguments(args UNIX_COMMAND "${case}")
     add_rostest(test/ros/robots_run.test ARGS ${args})
   endforeach()

@@ -36,7 +36,9 @@ LockstepAgent::LockstepAgent(const Scenario& scenario, int id, StartMethod start
 }
 
 LockstepAgent::CommandReceipt LockstepAgent::receiveCommand(long step, const Command& command, std::string* error) {
-  if (step < step_) return CommandReceipt::Late;
+  // Late only for an interval this incarnation has used: after a resume, before its first
+  // update, the commands of the steps before it are still to come (the latched list).
+  if (step < step_ && advanced_) return CommandReceipt::Late;
   try {
     validateCommand(command, dimension_, coefficients_.timeStep, CommandFieldNames::keys("command"));
   } catch (const InvalidInput& e) {
@@ -142,6 +144,7 @@ void LockstepAgent::advance() {
   qPrev_.swap(q_);
   q_.swap(next);
   ++step_;
+  advanced_ = true;
 }
 
 // doc/maths.md §9, as in ManoeuvreIntegrator::step.
@@ -172,6 +175,7 @@ void LockstepAgent::resume(long step, const std::vector<double>& position,
   q_ = position;
   qPrev_ = previousPosition;
   qBeforePrev_ = previousPosition;
+  advanced_ = false;
 }
 
 bool LockstepAgent::finite() const {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Geometry>
 #include <Eigen/SVD>
 
 namespace vf {
@@ -63,6 +64,22 @@ double maxScaledDistanceError(const Formation& formation, const Positions& q, do
     worst = std::max(worst, std::abs((q.col(e.tail) - q.col(e.head)).norm() - scale * e.desiredDistance));
   }
   return worst;
+}
+
+CommandedFrame commandedFrame(const CommandSchedule& schedule, long step, double timeStep) {
+  CommandedFrame frame;
+  const Command& now = schedule.at(step);
+  frame.scale = now.scale;
+  frame.velocity = now.velocity;
+  const auto& entries = schedule.entries();
+  for (std::size_t e = 0; e < entries.size() && entries[e].first < step; ++e) {
+    const long end = e + 1 < entries.size() ? std::min(entries[e + 1].first, step) : step;
+    const Vector3& w = entries[e].second.angularRate;
+    const double angle = w.norm() * timeStep * static_cast<double>(end - entries[e].first);
+    // Each interval turns by exp(omega* h) about the same axis: together, one angle.
+    if (angle > 0.0) frame.rotation = Eigen::AngleAxisd(angle, w.normalized()).toRotationMatrix() * frame.rotation;
+  }
+  return frame;
 }
 
 }  // namespace vf

@@ -98,12 +98,14 @@ void AgentNode::onProgress(const ros::MessageEvent<RunProgress const>& event) {
     exitStatus_ = p.state == RunProgress::FINISHED ? 0 : 1;
   } else {
     allowedStep_ = std::max(allowedStep_, static_cast<long>(p.allowed_step));
+    commandsCounted_ = p.commands;
     tryAdvance();
   }
 }
 
 void AgentNode::tryAdvance() {
-  while (exitStatus_ < 0 && failure_.empty() && !agent_->finished() && agent_->step() < allowedStep_ && agent_->ready()) {
+  while (exitStatus_ < 0 && failure_.empty() && !agent_->finished() && agent_->step() < allowedStep_ &&
+         commandsHeld_ >= commandsCounted_ && agent_->ready()) {
     const ros::WallTime now = ros::WallTime::now();
     if (!started_) {
       started_ = true;
@@ -164,6 +166,10 @@ std::string AgentNode::waitingFor() const {
     return allowedStep_ == 0 ? "the monitor " + monitor_ + " to start the run (it waits for every participant)"
                              : "the monitor " + monitor_ + " to allow step " + std::to_string(agent_->step() + 1) +
                                    " (flow control: it or the recorder is behind)";
+  }
+  if (commandsHeld_ < commandsCounted_) {
+    return "command " + std::to_string(commandsHeld_ + 1) + " of " + std::to_string(commandsCounted_) +
+           " on the monitor's latched `command`";
   }
   std::string missing;
   for (int j : agent_->neighbourIds()) {
@@ -232,6 +238,11 @@ void AgentNode::start(const Recovery& recovery) {
       nh_, agent_->neighbourIds(), 1000,
       [this](int j, const ros::MessageEvent<AgentState const>& e) { onNeighbourState(j, e); },
       [this](const ros::MessageEvent<RunProgress const>& e) { onProgress(e); }, subs_, progressSub_);
+  commandSub_ = nh_.subscribe<variational_formation::FormationCommands>(
+      "command", 10,
+      boost::function<void(const ros::MessageEvent<variational_formation::FormationCommands const>&)>(
+          [this](const ros::MessageEvent<variational_formation::FormationCommands const>& e) { onCommands(e); }),
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
   publish();  // the first state (step 0, or the recovered one), latched
   lastReportAt_ = ros::WallTime::now();
   // Every 2.5 s (a waiting line every 5 s at most): a manager holds hundreds of agents, and each

@@ -45,6 +45,7 @@ LockstepMonitor::LockstepMonitor(ros::NodeHandle& nh, ros::NodeHandle& pnh) : Mo
   }
   recallServer_ = pnh.advertiseService("recall", &LockstepMonitor::onRecall, this);
   historyServer_ = pnh.advertiseService("history", &LockstepMonitor::onHistory, this);
+  setUpCommands(nh, pnh);
   announce(recorder_.node);
 }
 
@@ -86,7 +87,8 @@ void LockstepMonitor::publishCompleted() {
   for (const FormationSnapshot& s : referee_->takeCompleted()) {
     ros::Time stamp;
     stamp.fromSec(s.metrics.time);  // simulated time t_k
-    referee_->keep(s.metrics.step, publishSnapshot(s, stamp, 0.0, true));
+    // The Noether predictions are those of the unforced run: NaN under a commanded motion.
+    referee_->keep(s.metrics.step, publishSnapshot(s, stamp, 0.0, commandSchedule() == nullptr));
   }
   updateProgress();
 }
@@ -94,13 +96,18 @@ void LockstepMonitor::publishCompleted() {
 void LockstepMonitor::updateProgress() {
   if (ended()) return;
   const bool waiting = !referee_->running();
-  if (!referee_->updateProgress(!waitForViewer_ || markersPub_.getNumSubscribers() > 0)) return;
-  if (referee_->ended()) {
+  const bool changed = referee_->updateProgress(!waitForViewer_ || markersPub_.getNumSubscribers() > 0);
+  if (changed && referee_->ended()) {
     finish(RunProgress::FINISHED, "");  // the referee ends a run only by finishing it here
     return;
   }
+  RunProgress next = toMessage(referee_->progressNow());
+  // A pending command goes out at the allowed step, before the progress that counts it.
+  const long issuedBefore = commandsIssued_;
+  next.commands = issueCommands(next.allowed_step);
+  if (!changed && next.commands == issuedBefore) return;
   if (waiting && referee_->running()) startedAt_ = ros::WallTime::now();
-  publishProgress(toMessage(referee_->progressNow()));
+  publishProgress(next);
 }
 
 void LockstepMonitor::watch() {
@@ -221,12 +228,16 @@ void LockstepMonitor::begin() {
   if (!referee_->resume(answers, histories)) {
     // It did not witness a run that is over: neither its outcome nor a new run is its to report.
     if (referee_->ended()) finish(RunProgress::FAILED, referee_->progressNow().reason);
+    if (!ended()) resumeCommands(false);
     return;  // or a new run
   }
+  resumeCommands(true);
+  if (ended()) return;
   const protocol::MonitorResume& r = referee_->resumedFrom();
   reportedConvergence_ = r.congruentSince >= 0 ? r.congruentSince : -2;
   firstStepAt_ = startedAt_ = ros::WallTime::now();
   progress_ = toMessage(referee_->progressNow());
+  progress_.commands = commandsIssued_;
   for (Participant& a : agents_) a.seen = true;
   ROS_INFO("monitor: resuming a run in progress at step %ld (rebuilt from the agents' histories)", r.step);
   lastCompletedAt_ = ros::WallTime::now();

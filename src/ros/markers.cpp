@@ -93,22 +93,42 @@ double markerRadius(const Formation& formation) {
   return std::max(0.05, 0.1 * scale);
 }
 
-/// Where the desired shape is drawn: its agents moved so that its centroid is the formation's.
+/// Where the desired shape is drawn: its agents moved so that its centroid is the formation's,
+/// and, under a commanded motion, turned and scaled as the commands have so far.
 struct Ghost {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();         ///< of the current positions
   Eigen::Vector3d desiredCentroid = Eigen::Vector3d::Zero();  ///< of the desired shape
+  CommandedFrame frame;
 
-  Ghost(const FormationSnapshot& s, const Formation& formation) {
+  Ghost(const FormationSnapshot& s, const Formation& formation, const CommandSchedule* schedule, double h) {
     const int n = formation.agentCount();
     for (int i = 0; i < n; ++i) {
       centroid += column3(s.positions, i) / n;
       desiredCentroid += column3(formation.desiredShape(), i) / n;
     }
+    if (schedule) frame = commandedFrame(*schedule, s.metrics.step, h);
   }
   geometry_msgs::Point agent(const Formation& formation, int i) const {
-    return point(column3(formation.desiredShape(), i) - desiredCentroid + centroid);
+    return point(frame.scale * (frame.rotation * (column3(formation.desiredShape(), i) - desiredCentroid)) + centroid);
   }
 };
+
+/// The commanded velocity v* as an arrow from the centroid (its length: one second of travel);
+/// deleted while v* is zero.
+Marker commandArrow(const Ghost& ghostAt, double radius, const ros::Time& stamp) {
+  Marker m = base("command", 0, Marker::ARROW, stamp);
+  if (ghostAt.frame.velocity.isZero(0.0)) {
+    m.action = Marker::DELETE;
+    return m;
+  }
+  m.points.push_back(point(ghostAt.centroid));
+  m.points.push_back(point(ghostAt.centroid + ghostAt.frame.velocity));
+  m.scale.x = 0.3 * radius;  // shaft diameter
+  m.scale.y = 0.7 * radius;  // head diameter
+  m.scale.z = 0.0;           // default head length
+  m.color = rgba(1.0, 0.85, 0.1, 0.9);
+  return m;
+}
 
 /// Per agent, a sphere at q_i and a line strip through its trail (at least two points).
 void addAgentsAndTrails(const FormationSnapshot& s, const std::vector<std::deque<Eigen::Vector3d>>& trails,
@@ -188,16 +208,18 @@ Marker statusText(const FormationSnapshot& s, int agents, const Ghost& ghostAt, 
 }  // namespace
 
 visualization_msgs::MarkerArray makeMarkers(const FormationSnapshot& s, const Formation& formation,
-                                            const std::vector<std::deque<Eigen::Vector3d>>& trails) {
+                                            const std::vector<std::deque<Eigen::Vector3d>>& trails,
+                                            const CommandSchedule* schedule, double timeStep) {
   visualization_msgs::MarkerArray out;
   const ros::Time stamp = ros::Time::now();
   const int n = formation.agentCount();
   const double radius = markerRadius(formation);
-  const Ghost ghostAt(s, formation);
+  const Ghost ghostAt(s, formation, schedule, timeStep);
   addAgentsAndTrails(s, trails, n, radius, stamp, out);
   addEdgesAndGhostEdges(s, formation, ghostAt, radius, stamp, out);
   out.markers.push_back(ghostAgents(formation, ghostAt, radius, stamp));
   out.markers.push_back(statusText(s, n, ghostAt, radius, stamp));
+  if (schedule) out.markers.push_back(commandArrow(ghostAt, radius, stamp));
   return out;
 }
 

@@ -48,7 +48,7 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
   const long last = scenario_.steps;
   const bool edge = s.metrics.step == 0 || (last > 0 && s.metrics.step == last);
   if (edge || (s.metrics.step % markerEvery_ == 0 && (recording_ || markersPub_.getNumSubscribers() > 0))) {
-    out.second = makeMarkers(s, measure().formation(), trails_);
+    out.second = makeMarkers(s, measure().formation(), trails_, commandSchedule(), scenario_.timeStep);
     for (auto& m : out.second.markers) {
       m.header.stamp = stamp;
       m.header.frame_id = worldFrame_;
@@ -76,7 +76,8 @@ void MonitorNode::writeResult(const std::string& result, const std::string& reas
   const FormationOutcome formation = formationOutcome(convergedStep_, finalError_, scenario_.timeStep);
   f << "result: " << result << "\nscenario: " << scenario_.name << "\nsteps: " << scenario_.steps
     << "\ncompleted_step: " << completedStep() << "\nconverged_step: " << convergedStep_ << "\nformation: \""
-    << formation.line << "\"\nfinal_max_distance_error: " << finalError_ << "\ndropped: " << dropped_
+    << formation.line << "\"\nfinal_max_distance_error: " << finalError_ << "\ndropped: " << dropped_ << "\ncommands: " << commandsIssued_
+    << "\ncommands_refused: " << commandsRefused_
     << "\nreason: \"" << quoted << "\"\n";
   if (!f) ROS_ERROR("monitor: cannot write the result file %s", resultFile_.c_str());
 }

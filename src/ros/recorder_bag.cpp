@@ -64,6 +64,7 @@ void RecorderNode::flush() {
   // Steps are written whole and in order, so the bag's messages are in time order: readers that
   // trust it (Python's rosbag merges chunks assuming it) see every stream in step order.
   for (const Steps::Step& step : steps_->takeWhole()) {
+    writeCommandsUpTo(step.step);
     for (std::size_t i = 0; i < step.states.size(); ++i) {
       const AgentState& msg = *step.states[i];
       write(stateTopics_[i], msg, msg.header.stamp);
@@ -75,6 +76,17 @@ void RecorderNode::flush() {
     if (step.hasMarkers) write(markersTopic_, *step.markers, markersStamp(*step.markers));
   }
   report();
+}
+
+void RecorderNode::writeCommandsUpTo(long step) {
+  std::size_t through = commandsInBag_;
+  while (through < commands_.commands.size() && commands_.commands[through].step <= step) ++through;
+  if (through == commandsInBag_) return;
+  variational_formation::FormationCommands so_far;
+  so_far.header.stamp = ros::Time(static_cast<double>(step) * timeStep_);
+  so_far.commands.assign(commands_.commands.begin(), commands_.commands.begin() + static_cast<long>(through));
+  write(commandsTopic_, so_far, so_far.header.stamp);
+  commandsInBag_ = through;
 }
 
 void RecorderNode::close(const std::string& how) {

@@ -22,7 +22,8 @@ const uint32_t kQueue = static_cast<uint32_t>(kBuffers.queue);
 }  // namespace
 
 RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), states_(1, 1) {
-  const Scenario scenario = loadScenario(requiredParam<std::string>(pnh, "scenario"));
+  scenario_ = loadScenario(requiredParam<std::string>(pnh, "scenario"));
+  const Scenario& scenario = scenario_;
   path_ = outputPath(nh, requiredParam<std::string>(pnh, "bag"));
   monitor_ = participantName(nh, optionalParam<std::string>(pnh, "monitor", "monitor"));
   managers_ = agentManagers(nh, pnh);
@@ -81,6 +82,7 @@ RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh),
       "progress", 10,
       boost::function<void(const ros::MessageEvent<RunProgress const>&)>(
           [this](const ros::MessageEvent<RunProgress const>& e) { onMonitorProgress(e); })));
+  setUpCommands(nh, pnh);
   progressPub_ = pnh.advertise<RunProgress>("progress", 10, true);
   progress_.state = RunProgress::WAITING;
   progress_.completed_step = -1;

@@ -96,6 +96,16 @@ class DistributedRun(unittest.TestCase, vf_rostest.RunChecks):
                 v0 = [(p - q) / h for p, q in zip(s0.position, s0.previous_position)]
                 for c in range(len(v1)):
                     self.assertAlmostEqual(v1[c], a * v0[c], delta=1e-10)
+        elif self.expect == "manoeuvre":
+            # The scenario's own schedule, with no topic: at the end every edge has s d_ij, s the
+            # last segment's scale, within 1e-3 (relative).
+            s = float(self.scenario["manoeuvre"][-1].get("scale", 1.0))
+            k = int(self.scenario["steps"])
+            q = {i: self.recording.states[(i, k)][0].position for i in range(n)}
+            desired = {a["id"]: a["desired_position"] for a in self.scenario["agents"]}
+            for a, b in self.scenario["edges"]:
+                ratio = math.dist(q[a], q[b]) / (s * math.dist(desired[a], desired[b]))
+                self.assertLess(abs(ratio - 1.0), 1e-3, f"edge {a}-{b}")
         else:
             self.fail(f"unknown ~expect {self.expect}")
         self.assertEqual(n, len({i for i, _ in self.recording.states}))

@@ -40,7 +40,8 @@ class LockstepAgent {
    * A broadcast command for the intervals from `step` on (doc/maths.md §9): it replaces the
    * schedule (the scenario's `manoeuvre:` or earlier commands) from that step on. The update at
    * step k (q_k -> q_{k+1}) uses the commands of intervals k - 1 and k, so a command is Late
-   * unless step >= step(); Invalid if validateCommand refuses it (`error` says why); CannotTurn
+   * if step < step() and the agent has advanced since its start or its last resume() (a resumed
+   * agent takes the commands of the steps before it until its first update); Invalid if validateCommand refuses it (`error` says why); CannotTurn
    * if it turns and this agent's motion parameters are not exact. Refused commands change nothing.
    * With the same commands at the same steps, the agents compute what ManoeuvreIntegrator
    * computes, bit for bit.
@@ -99,6 +100,7 @@ class LockstepAgent {
   int id_;
   int dimension_;
   long step_ = 0;
+  bool advanced_ = false;  // advance() ran since the start or the last resume()
   std::vector<double> qPrev_, q_, v0_, qBeforePrev_;
   std::vector<int> neighbourIds_;
   std::vector<NeighbourState> neighbours_;  // indexed by agent id (only neighbours used)

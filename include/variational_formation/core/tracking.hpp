@@ -1,6 +1,7 @@
 #pragma once
 
 #include "variational_formation/core/formation.hpp"
+#include "variational_formation/core/manoeuvre_command.hpp"
 
 namespace vf {
 
@@ -26,5 +27,15 @@ double meanScaleError(const Formation& formation, const Positions& q, double sca
 
 /// max over edges of | |q_i - q_j| - s d_ij | [m] (Formation::maxDistanceError when s = 1).
 double maxScaledDistanceError(const Formation& formation, const Positions& q, double scale);
+
+/// Where a commanded motion has taken the desired shape by step k (the monitor's ghost).
+struct CommandedFrame {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  ///< exp(omega*_j h) over intervals j < k, in order
+  double scale = 1.0;                                       ///< s of interval k
+  Vector3 velocity = Vector3::Zero();                       ///< v* of interval k [m/s]
+};
+
+/// The commanded frame at step k >= 0 of `schedule` at time step h [s]; O(number of entries).
+CommandedFrame commandedFrame(const CommandSchedule& schedule, long step, double timeStep);
 
 }  // namespace vf

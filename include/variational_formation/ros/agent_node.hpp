@@ -10,6 +10,7 @@
 #include <deque>
 
 #include "variational_formation/AgentState.h"
+#include "variational_formation/FormationCommands.h"
 #include "variational_formation/RecallHistory.h"
 #include "variational_formation/RecallState.h"
 #include "variational_formation/RunProgress.h"
@@ -66,6 +67,8 @@ class AgentNode {
  private:
   void onNeighbourState(int neighbour, const ros::MessageEvent<AgentState const>& event);
   void onProgress(const ros::MessageEvent<RunProgress const>& event);
+  /// The monitor's list of issued commands (src/ros/agent_commands.cpp): applies the new ones.
+  void onCommands(const ros::MessageEvent<variational_formation::FormationCommands const>& event);
   void tryAdvance();
   void publish();
   void reportWaiting();
@@ -81,7 +84,9 @@ class AgentNode {
   std::vector<ros::Subscriber> subs_;
   std::vector<std::string> neighbourOwners_;  // full node names, indexed like neighbourIds()
   std::vector<std::string> managers_;         // ~agent_manager: nodelet managers of agents
-  ros::Subscriber progressSub_;
+  ros::Subscriber progressSub_, commandSub_;
+  long commandsHeld_ = 0;     // commands of the monitor's list applied
+  long commandsCounted_ = 0;  // commands the newest progress counts: the agent steps only once it holds them
   ros::ServiceServer recallServer_, historyServer_;
   std::deque<AgentState::ConstPtr> history_;  // published states after the last completed step
   // Neighbours' states accepted after the last completed step, indexed like neighbourIds(): a

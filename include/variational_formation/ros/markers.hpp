@@ -9,6 +9,7 @@
 #include "variational_formation/AgentState.h"
 #include "variational_formation/FormationStatus.h"
 #include "variational_formation/core/monitor.hpp"
+#include "variational_formation/core/tracking.hpp"
 
 namespace vf {
 
@@ -24,10 +25,14 @@ FormationStatus toStatusMessage(const FormationSnapshot& snapshot);
 /**
  * rviz markers of a snapshot in frame world: a sphere per agent, the edges coloured by their
  * distance error (green 0 to red >= 10% of d_ij), a trail per agent, the desired shape as a
- * faint ghost centred on the current centroid, and a text with step, energy and error.
+ * faint ghost centred on the current centroid, and a text with step, energy and error. Under a
+ * commanded motion (`schedule`), the ghost is turned and scaled as the commands have turned and
+ * scaled the shape by this step (commandedFrame), and an arrow from the centroid shows v*.
  * @param trails per agent, the recent positions (oldest first).
+ * @param schedule the commands the agents apply, or nullptr. @param timeStep h [s].
  */
 visualization_msgs::MarkerArray makeMarkers(const FormationSnapshot& snapshot, const Formation& formation,
-                                            const std::vector<std::deque<Eigen::Vector3d>>& trails);
+                                            const std::vector<std::deque<Eigen::Vector3d>>& trails,
+                                            const CommandSchedule* schedule = nullptr, double timeStep = 0.0);
 
 }  // namespace vf

@@ -10,6 +10,7 @@
 
 #include "variational_formation/ros/state_batch.hpp"
 #include "variational_formation/AgentState.h"
+#include "variational_formation/FormationCommands.h"
 #include "variational_formation/FormationStatus.h"
 #include "variational_formation/RecallHistory.h"
 #include "variational_formation/RunProgress.h"
@@ -79,10 +80,18 @@ class RecorderNode {
   void fail(const std::string& reason);
   void openPart();
   void enforceLimits();
+  // Live commands (src/ros/recorder_commands.cpp).
+  void setUpCommands(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  void onCommands(const ros::MessageEvent<variational_formation::FormationCommands const>& event);
+  /// Writes the commands that apply from `step` on (or earlier) and are not in the bag yet, as the
+  /// list so far, at t_step: just before the step's states.
+  void writeCommandsUpTo(long step);
+  /// The whole schedule the agents apply, as a `simulate --commands` file (~commands_file).
+  void writeCommandsFile() const;
 
   ros::NodeHandle nh_;
   rosbag::Bag bag_;
-  std::string path_, monitor_, statusTopic_, markersTopic_;
+  std::string path_, monitor_, statusTopic_, markersTopic_, commandsTopic_;
   std::vector<std::string> stateTopics_, frameIds_;  // by agent
   std::vector<ros::Subscriber> subs_;
   ros::Publisher progressPub_;
@@ -106,6 +115,10 @@ class RecorderNode {
   double splitBytes_ = 0.0, maxBytes_ = 0.0, closedBytes_ = 0.0;
   int part_ = 0;
   int exitStatus_ = -1;
+  Scenario scenario_;
+  std::string commandsFile_;  // ~commands_file ("" : none)
+  variational_formation::FormationCommands commands_;  // the monitor's newest list
+  std::size_t commandsInBag_ = 0;
 };
 
 }  // namespace vf

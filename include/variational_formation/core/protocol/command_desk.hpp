@@ -1,0 +1,82 @@
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "variational_formation/core/manoeuvre_command.hpp"
+#include "variational_formation/core/scenario.hpp"
+
+namespace vf {
+namespace protocol {
+
+/// One issued command: the step from which it applies, and the command.
+using IssuedCommand = std::pair<long, Command>;
+
+/**
+ * The scenario's own schedule (its `manoeuvre:`) with the issued commands applied in order, each
+ * replacing the schedule from its step on (CommandSchedule::replaceFrom): what every agent
+ * applies, and what a `simulate --commands` file must hold to compute the same run.
+ */
+CommandSchedule appliedSchedule(const Scenario& scenario, const std::vector<IssuedCommand>& issued);
+
+/**
+ * The monitor's side of live commands in a lockstep run (doc/protocol.md, "Commands"), without a
+ * transport. Inputs are the two halves of a command: a velocity (cmd_vel: v*, omega*) and a scale
+ * (s); each is checked (validateCommand, and whether the formation can turn) and, if good, makes
+ * a pending command: the one that applies at the next issue with that half replaced.
+ *
+ * Issue: a pending command is stamped with the allowed step A of the progress the monitor has
+ * published (agents hold at most q_A, and the update from A uses intervals A - 1 and A, so a
+ * command for interval A reaches every agent in time), at most one per value of A: a second
+ * input before A moves stays pending and is issued, merged, at the next A. The monitor publishes
+ * the list before any progress that allows a step beyond A, and that progress counts the list;
+ * an agent steps only while it holds that many commands.
+ */
+class CommandDesk {
+ public:
+  /// @param scenario validated (its dimension, h, manoeuvre and formation).
+  explicit CommandDesk(const Scenario& scenario);
+
+  /// A velocity command (v*, omega*). @return false with `why` (one line) if it is refused.
+  bool offerVelocity(const Vector3& velocity, const Vector3& angularRate, std::string& why);
+  /// A scale command (s). @return false with `why` if it is refused.
+  bool offerScale(double scale, std::string& why);
+
+  /// A command waits to be issued.
+  bool pending() const { return pending_; }
+  /**
+   * Issues the pending command at `allowedStep` (>= 0) if there is one and nothing was issued at
+   * this step or later yet. @return whether it issued one.
+   */
+  bool issue(long allowedStep);
+
+  /// Every command issued so far, oldest first.
+  const std::vector<IssuedCommand>& issued() const { return issued_; }
+  /// The schedule the agents apply (appliedSchedule of the issued commands).
+  const CommandSchedule& schedule() const { return schedule_; }
+
+  /**
+   * A restarted monitor goes on from what the monitor before it issued (kept on the parameter
+   * server before it was published, so nothing an agent applied is missing). Replaces the issued
+   * list and the schedule; nothing is pending.
+   */
+  void resume(const std::vector<IssuedCommand>& issued);
+
+ private:
+  /// The command of the next issue: what the schedule has at that step, with the offered halves.
+  Command nextAt(long step) const;
+
+  Scenario scenario_;
+  bool canTurn_ = true;
+  std::string whyNoTurn_;
+  bool pending_ = false;
+  bool pendingVelocity_ = false, pendingScale_ = false;
+  Vector3 velocity_ = Vector3::Zero(), angularRate_ = Vector3::Zero();
+  double scale_ = 1.0;
+  std::vector<IssuedCommand> issued_;
+  CommandSchedule schedule_;
+};
+
+}  // namespace protocol
+}  // namespace vf

@@ -1,0 +1,282 @@
+// protocol::CommandDesk: which live commands the monitor accepts, the step it stamps them with,
+// and the rule that makes every agent apply them at the same step. The randomised test runs the
+// lockstep protocol with commands arriving at random moments, lists and progress delivered late
+// (in order, per topic), agents killed and resumed, and the monitor restarted from the agents'
+// lists, and checks every agent's every step against ManoeuvreIntegrator on the applied schedule,
+// bit for bit. A failing seed is printed.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <deque>
+#include <random>
+
+#include "test_support.hpp"
+#include "variational_formation/core/lockstep_agent.hpp"
+#include "variational_formation/core/manoeuvre_integrator.hpp"
+#include "variational_formation/core/protocol/command_desk.hpp"
+
+namespace vf {
+namespace {
+
+using protocol::CommandDesk;
+using protocol::IssuedCommand;
+
+Scenario hexagon(long steps) {
+  Scenario s = loadScenario(test::configPath("hexagon_manoeuvre"));
+  s.manoeuvre.clear();
+  s.steps = steps;
+  return s;
+}
+
+TEST(CommandDesk, RefusesBadCommandsSayingWhy) {
+  CommandDesk desk(hexagon(100));
+  std::string why;
+  EXPECT_FALSE(desk.offerVelocity({NAN, 0, 0}, {0, 0, 0}, why));
+  EXPECT_EQ(why, "cmd_vel.velocity: must be finite");
+  EXPECT_FALSE(desk.offerVelocity({0, 0, 0.5}, {0, 0, 0}, why));
+  EXPECT_EQ(why.rfind("cmd_vel.velocity: a 2D formation has no z velocity", 0), 0u) << why;
+  EXPECT_FALSE(desk.offerVelocity({0, 0, 0}, {0.1, 0, 0}, why));
+  EXPECT_EQ(why.rfind("cmd_vel.angular_rate: a 2D formation turns about z only", 0), 0u) << why;
+  EXPECT_FALSE(desk.offerScale(0.0, why));
+  EXPECT_EQ(why, "scale.scale: must be finite and > 0, got 0");
+  EXPECT_FALSE(desk.offerScale(-1.0, why));
+  EXPECT_FALSE(desk.pending());
+  EXPECT_FALSE(desk.issue(10));
+  EXPECT_TRUE(desk.issued().empty());
+}
+
+TEST(CommandDesk, RefusesTurningAFormationThatCannotTurn) {
+  // A triangle with one edge missing is not rigid: agents cannot know their offsets.
+  Scenario s = loadScenario(test::configPath("square"));
+  CommandDesk desk(s);
+  std::string why;
+  const bool turns = desk.offerVelocity({0, 0, 0}, {0, 0, 0.3}, why);
+  // The square qualifies or not; either way a refusal names the field and says why.
+  if (!turns) EXPECT_EQ(why.rfind("angular_rate: ", 0), 0u) << why;
+  EXPECT_TRUE(desk.offerVelocity({0.2, 0, 0}, {0, 0, 0}, why)) << why;
+}
+
+TEST(CommandDesk, StampsAtTheAllowedStepOncePerStepAndMergesWhatWaits) {
+  CommandDesk desk(hexagon(1000));
+  std::string why;
+  ASSERT_TRUE(desk.offerVelocity({0.5, 0, 0}, {0, 0, 0.2}, why)) << why;
+  ASSERT_TRUE(desk.issue(40));
+  ASSERT_EQ(desk.issued().size(), 1u);
+  EXPECT_EQ(desk.issued()[0].first, 40);
+  EXPECT_EQ(desk.issued()[0].second, test::command({0.5, 0, 0}, {0, 0, 0.2}, 1.0));
+  // Before the allowed step moves, a new input waits; then both halves go out merged.
+  ASSERT_TRUE(desk.offerScale(1.5, why));
+  EXPECT_FALSE(desk.issue(40));
+  ASSERT_TRUE(desk.offerVelocity({0, 0.3, 0}, {0, 0, 0}, why));
+  EXPECT_TRUE(desk.pending());
+  ASSERT_TRUE(desk.issue(65));
+  EXPECT_EQ(desk.issued()[1], IssuedCommand(65, test::command({0, 0.3, 0}, {0, 0, 0}, 1.5)));
+  // Only the scale: the velocity in force at that step is kept.
+  ASSERT_TRUE(desk.offerScale(0.8, why));
+  ASSERT_TRUE(desk.issue(90));
+  EXPECT_EQ(desk.issued()[2], IssuedCommand(90, test::command({0, 0.3, 0}, {0, 0, 0}, 0.8)));
+  EXPECT_FALSE(desk.pending());
+  EXPECT_EQ(desk.schedule().at(89), desk.issued()[1].second);
+  EXPECT_EQ(desk.schedule().at(1000), desk.issued()[2].second);
+}
+
+TEST(CommandDesk, TheScenarioScheduleIsKeptUntilACommandReplacesItFromItsStep) {
+  const Scenario s = loadScenario(test::configPath("hexagon_manoeuvre"));
+  const CommandSchedule own = scheduleFromSegments(s.manoeuvre, s.timeStep);
+  ASSERT_GE(own.entries().size(), 2u);
+  const long second = own.entries()[1].first;
+  CommandDesk desk(s);
+  std::string why;
+  ASSERT_TRUE(desk.offerScale(2.0, why));
+  ASSERT_TRUE(desk.issue(second - 10));
+  // The command keeps the scenario's velocity at that step and drops its later entries.
+  const Command& c = desk.issued()[0].second;
+  EXPECT_EQ(c.velocity, own.at(second - 10).velocity);
+  EXPECT_EQ(c.scale, 2.0);
+  EXPECT_EQ(desk.schedule().at(second + 100), c);
+  EXPECT_EQ(desk.schedule().at(second - 11), own.at(second - 11));
+  const CommandSchedule applied = protocol::appliedSchedule(s, desk.issued());
+  EXPECT_EQ(applied.entries(), desk.schedule().entries());
+}
+
+TEST(CommandDesk, ARestartedMonitorGoesOnFromWhatWasIssued) {
+  CommandDesk before(hexagon(1000));
+  std::string why;
+  for (long step : {10L, 30L, 50L}) {
+    ASSERT_TRUE(before.offerScale(1.0 + step / 100.0, why));
+    ASSERT_TRUE(before.issue(step));
+  }
+  const std::vector<IssuedCommand> all = before.issued();
+  CommandDesk after(hexagon(1000));
+  after.resume(all);
+  EXPECT_EQ(after.issued(), all);
+  EXPECT_EQ(after.schedule().entries(), before.schedule().entries());
+  ASSERT_TRUE(after.offerScale(3.0, why));
+  EXPECT_FALSE(after.issue(50));  // never at or before the last issued step
+  EXPECT_TRUE(after.issue(51));
+}
+
+// The lockstep protocol with live commands, driven by one seed (see the file comment).
+struct CommandWorld {
+  Scenario s;
+  std::mt19937 rng;
+  long window;
+  std::vector<LockstepAgent> agents;
+  std::vector<std::size_t> applied;     // how many listed commands each agent has applied
+  std::vector<long> allowedSeen, countSeen;
+  // Per agent, what the topics still have to deliver, in order: (allowed step, command count)
+  // progress messages, and whole lists.
+  std::vector<std::deque<std::pair<long, long>>> progressInFlight;
+  std::vector<std::deque<std::vector<IssuedCommand>>> listsInFlight;
+  std::unique_ptr<CommandDesk> desk;
+  long allowed = 0;
+
+  CommandWorld(Scenario scenario, unsigned seed, long w) : s(std::move(scenario)), rng(seed), window(w) {
+    desk = std::make_unique<CommandDesk>(s);
+    const auto n = static_cast<std::size_t>(s.agentCount());
+    for (int i = 0; i < s.agentCount(); ++i) agents.emplace_back(s, i);
+    applied.assign(n, 0);
+    allowedSeen.assign(n, 0);
+    countSeen.assign(n, 0);
+    progressInFlight.resize(n);
+    listsInFlight.resize(n);
+  }
+  bool chance(double p) { return std::uniform_real_distribution<double>(0.0, 1.0)(rng) < p; }
+  double uniform(double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); }
+
+  // The monitor: what it publishes, list first, then the progress that counts it.
+  void publish() {
+    for (auto& q : listsInFlight) q.push_back(desk->issued());
+    for (auto& q : progressInFlight) q.emplace_back(allowed, static_cast<long>(desk->issued().size()));
+  }
+  long completed() const {
+    long c = s.steps;
+    for (const auto& a : agents) c = std::min(c, a.step());
+    return c;
+  }
+  void monitorTick() {
+    if (chance(0.3)) {
+      std::string why;
+      if (chance(0.5)) {
+        desk->offerVelocity({uniform(-1, 1), uniform(-1, 1), 0}, {0, 0, chance(0.5) ? uniform(-0.5, 0.5) : 0.0}, why);
+      } else {
+        desk->offerScale(uniform(0.7, 1.5), why);
+      }
+    }
+    const long next = std::min(completed() + window, s.steps);
+    if (desk->issue(allowed) || next > allowed) {
+      allowed = std::max(allowed, next);
+      publish();
+    }
+  }
+  // The monitor keeps what it issued on the parameter server before it publishes it: a new one
+  // goes on from there (what was pending, not issued yet, is gone with it).
+  void restartMonitor() {
+    const std::vector<IssuedCommand> kept = desk->issued();
+    desk = std::make_unique<CommandDesk>(s);
+    desk->resume(kept);
+    publish();
+  }
+  void deliver(std::size_t i) {
+    while (!listsInFlight[i].empty() && chance(0.6)) {
+      const std::vector<IssuedCommand> list = listsInFlight[i].front();
+      listsInFlight[i].pop_front();
+      for (; applied[i] < list.size(); ++applied[i]) {
+        const IssuedCommand& c = list[applied[i]];
+        ASSERT_EQ(agents[i].receiveCommand(c.first, c.second), LockstepAgent::CommandReceipt::Accepted)
+            << "agent " << i << " at step " << agents[i].step() << ", command at " << c.first;
+      }
+    }
+    while (!progressInFlight[i].empty() && chance(0.6)) {
+      allowedSeen[i] = std::max(allowedSeen[i], progressInFlight[i].front().first);
+      // The newest progress's count, not the largest: a restarted monitor may count fewer (a
+      // command the monitor before it issued, which no agent received, is gone with it).
+      countSeen[i] = progressInFlight[i].front().second;
+      progressInFlight[i].pop_front();
+    }
+  }
+  // An agent killed and resumed from its own newest state, with no command and no progress: the
+  // latched topics give it the newest list and progress again.
+  void kill(std::size_t i) {
+    const long step = agents[i].step();
+    const std::vector<double> q = agents[i].position(), qPrev = agents[i].previousPosition();
+    agents[i] = LockstepAgent(s, static_cast<int>(i));
+    agents[i].resume(step, q, qPrev);
+    for (const auto& a : agents) {
+      if (a.id() != static_cast<int>(i)) agents[i].receive(a.id(), a.step(), a.position(), a.previousPosition());
+    }
+    applied[i] = 0;
+    allowedSeen[i] = countSeen[i] = 0;
+    progressInFlight[i].assign(1, {allowed, static_cast<long>(desk->issued().size())});
+    listsInFlight[i].assign(1, desk->issued());
+  }
+};
+
+void runCommandWorld(const Scenario& scenario, unsigned seed, long window, bool faults) {
+  SCOPED_TRACE("seed " + std::to_string(seed) + " (test_command_desk --gtest_filter=*Random*)");
+  CommandWorld w(scenario, seed, window);
+  std::vector<std::vector<std::vector<double>>> computed(w.agents.size());
+  for (std::size_t i = 0; i < w.agents.size(); ++i) computed[i].push_back(w.agents[i].position());
+  for (auto& a : w.agents) {  // every agent's state at step 0
+    for (const auto& b : w.agents) a.receive(b.id(), b.step(), b.position(), b.previousPosition());
+  }
+  w.publish();
+  for (long tick = 0; tick < 200000 && w.completed() < w.s.steps; ++tick) {
+    w.monitorTick();
+    if (faults && w.chance(0.002)) w.restartMonitor();
+    for (std::size_t i = 0; i < w.agents.size(); ++i) {
+      w.deliver(i);
+      if (::testing::Test::HasFatalFailure()) return;
+      if (faults && w.chance(0.003)) w.kill(i);
+      LockstepAgent& a = w.agents[i];
+      // The gate: within the allowed step, with every neighbour's state and every counted command.
+      if (!a.finished() && a.step() < w.allowedSeen[i] && a.ready() &&
+          static_cast<long>(w.applied[i]) >= w.countSeen[i] && w.chance(0.7)) {
+        a.advance();
+        if (static_cast<long>(computed[i].size()) == a.step()) computed[i].push_back(a.position());
+        ASSERT_EQ(computed[i][static_cast<std::size_t>(a.step())], a.position()) << "agent " << i << " redid step "
+                                                                                 << a.step() << " differently";
+        for (auto& b : w.agents) b.receive(a.id(), a.step(), a.position(), a.previousPosition());
+      }
+    }
+  }
+  ASSERT_EQ(w.completed(), w.s.steps) << "the run stalled at step " << w.completed();
+  const CommandSchedule schedule = protocol::appliedSchedule(w.s, w.desk->issued());
+  const Formation formation = makeFormation(w.s);  // the integrator keeps a reference to it
+  ManoeuvreIntegrator reference(formation, w.s.initialPositions, w.s.initialVelocities, w.s.timeStep,
+                                w.s.dampingGain, StartMethod::Variational, schedule);
+  for (long k = 1; k <= w.s.steps; ++k) {
+    reference.step();
+    for (std::size_t i = 0; i < w.agents.size(); ++i) {
+      for (int c = 0; c < w.s.dimension; ++c) {
+        ASSERT_EQ(computed[i][static_cast<std::size_t>(k)][static_cast<std::size_t>(c)],
+                  reference.positions()(c, static_cast<long>(i)))
+            << "agent " << i << " step " << k << "; " << w.desk->issued().size() << " commands issued";
+      }
+    }
+  }
+  ASSERT_GT(w.desk->issued().size(), 0u);
+}
+
+TEST(CommandDesk, RandomInterleavingsEqualTheCentralisedRunBitForBit) {
+  for (unsigned seed = 1; seed <= 60; ++seed) {
+    runCommandWorld(hexagon(240), seed, 1 + seed % 12, false);
+    if (::testing::Test::HasFatalFailure()) return;
+  }
+}
+
+TEST(CommandDesk, RandomInterleavingsWithKillsAndMonitorRestartsEqualTheCentralisedRun) {
+  for (unsigned seed = 100; seed < 160; ++seed) {
+    runCommandWorld(hexagon(240), seed, 1 + seed % 12, true);
+    if (::testing::Test::HasFatalFailure()) return;
+  }
+  Scenario t = loadScenario(test::configPath("tetrahedron"));
+  t.steps = 150;
+  for (unsigned seed = 200; seed < 220; ++seed) {
+    runCommandWorld(t, seed, 5, true);
+    if (::testing::Test::HasFatalFailure()) return;
+  }
+}
+
+}  // namespace
+}  // namespace vf
