@@ -1,5 +1,6 @@
 # The ROS layer: thin nodes over the core, plus rostests.
-add_library(variational_formation_ros src/ros/agent_node.cpp src/ros/agent_commands.cpp src/ros/markers.cpp src/ros/monitor_node.cpp
+add_library(variational_formation_ros src/ros/agent_commands.cpp src/ros/agent_node.cpp src/ros/markers.cpp
+  src/ros/monitor_node.cpp
   src/ros/output_files.cpp
   src/ros/participants.cpp
   src/ros/recorder_node.cpp)
@@ -70,7 +71,8 @@ if(CATKIN_ENABLE_TESTING)
                "case:=within_margin scenario_name:=timed_hexagon_kappa4"
                "case:=beyond_margin scenario_name:=timed_hexagon_kappa4 expect:=not_converged delay:=0.07"
                "case:=kill kill:=2 respawn_delay:=1.5"
-               "case:=reconfigure scenario_name:=timed_hexagon_kappa4 delay:=0.07 reconfigure_kappa:=13")
+               "case:=reconfigure scenario_name:=timed_hexagon_kappa4 delay:=0.07 reconfigure_kappa:=13"
+               "case:=command command:=0.3_-0.2")
     separate_arguments(args UNIX_COMMAND "${case}")
     add_rostest(test/ros/timed_run.test ARGS ${args})
   endforeach()
@@ -88,6 +90,7 @@ if(CATKIN_ENABLE_TESTING)
   # unicycles from seeded headings; ring7 (delay margin 0.05 s) with lags 0.1 and 0.3 s.
   foreach(case "case:=hexagon"
                "case:=hexagon_unicycle kinematics:=unicycle heading_seed:=7 world_frame:=map"
+               "case:=hexagon_unicycle_command kinematics:=unicycle heading_seed:=9 command:=0.3_-0.2"
                "case:=ring7_lag01 scenario:=ring7 lag:=0.1 time_limit:=90 expect_lag_warning:=true"
                "case:=ring7_lag03 scenario:=ring7 lag:=0.3 time_limit:=90 expect_lag_warning:=true"
                "case:=ring7_unicycle_lag01 scenario:=ring7 lag:=0.1 kinematics:=unicycle heading_seed:=3 time_limit:=90 expect_lag_warning:=true"

@@ -18,6 +18,7 @@ AgentNeighbourhood::AgentNeighbourhood(const Scenario& scenario, int id)
   v0_.assign(scenario.initialVelocities.col(id).data(), scenario.initialVelocities.col(id).data() + d);
   for (const Neighbour& nb : formation_.neighbours(id)) neighbourIds_.push_back(nb.agent);
   view_ = Positions::Zero(d, n);
+  motion_ = motionParameters(formation_, id);
 }
 
 AgentNeighbourhood::StateCheck AgentNeighbourhood::check(long sender, const std::vector<double>& position,

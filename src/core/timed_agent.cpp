@@ -5,6 +5,7 @@
 
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/number_checks.hpp"
+#include "variational_formation/core/validation.hpp"
 
 namespace vf {
 
@@ -34,7 +35,17 @@ TimedAgent::TimedAgent(const Scenario& scenario, int id, double maxAge, StartMet
   qPrev_ = q_;
   v_ = neighbourhood_.initialVelocity();
   neighbours_.resize(static_cast<std::size_t>(scenario.agentCount()));
+  schedule_ = scheduleFromSegments(scenario.manoeuvre, scenario.timeStep);
 }
+
+void TimedAgent::setCommand(const Command& command) {
+  validateCommand(command, dimension_, coefficients_.timeStep, CommandFieldNames::keys("command"));
+  if (command.rotates() && !neighbourhood_.motion().exact) throw InvalidInput(neighbourhood_.motion().problem);
+  liveCommand_ = command;
+  live_ = true;
+}
+
+Command TimedAgent::command() const { return live_ ? liveCommand_ : schedule_.at(step_); }
 
 std::string TimedAgent::describe(Receipt receipt) {
   switch (receipt) {
@@ -112,10 +123,22 @@ TimedAgent::TickResult TimedAgent::tick(double now) {
     hold();
   } else {
     if (measured_) q_ = qMeasured_;
-    double gradient[3];
-    neighbourhood_.gradient(
-        q_.data(), [this](int j) { return neighbours_[static_cast<std::size_t>(j)].position.data(); }, gradient);
-    move(gradient);
+    const auto neighbourPosition = [this](int j) { return neighbours_[static_cast<std::size_t>(j)].position.data(); };
+    double gradient[3], offset[3] = {0.0, 0.0, 0.0};
+    if (!live_ && schedule_.empty()) {
+      neighbourhood_.gradient(q_.data(), neighbourPosition, gradient);  // no command: today's update
+      move(gradient, nullptr, nullptr);
+    } else {
+      // As LockstepAgent: the node gains between the previous tick's command and this one's.
+      const ManoeuvreGains now = manoeuvreGains(command(), coefficients_);
+      // Before the first command the agent moved with none: the zero command's gains.
+      const ManoeuvreGains before = haveLastGains_ ? lastGains_ : manoeuvreGains(Command{}, coefficients_);
+      const ManoeuvreGains g = started_ && !restart_ ? nodeGains(before, now) : now;
+      neighbourhood_.forcedGradient(q_.data(), neighbourPosition, g.scaleSquared, g.rotates, gradient, offset);
+      move(gradient, &g, offset);
+      lastGains_ = now;
+      haveLastGains_ = true;
+    }
   }
   measured_ = false;
   ++step_;
@@ -137,13 +160,15 @@ void TimedAgent::hold() {
   ++heldTicks_;
 }
 
-void TimedAgent::move(const double* gradient) {
+void TimedAgent::move(const double* gradient, const ManoeuvreGains* g, const double* offset) {
   std::vector<double> next(static_cast<std::size_t>(dimension_));
   const double h = coefficients_.timeStep;
   if (!started_ || restart_) {
     const std::vector<double> zero(static_cast<std::size_t>(dimension_), 0.0);
     const std::vector<double>& vStart = restart_ ? zero : neighbourhood_.initialVelocity();
-    if (start_ == StartMethod::Variational) {
+    if (start_ == StartMethod::Variational && g) {
+      manoeuvreStart(coefficients_, *g, dimension_, q_.data(), vStart.data(), gradient, offset, next.data());
+    } else if (start_ == StartMethod::Variational) {
       variationalStart(coefficients_, dimension_, q_.data(), vStart.data(), gradient, next.data());
     } else {
       paperStart(coefficients_, dimension_, q_.data(), vStart.data(), next.data());
@@ -152,9 +177,20 @@ void TimedAgent::move(const double* gradient) {
   } else if (measured_) {
     // Robot mode: q_k measured, v_{k-1} from our own command; the noise of q_k is not divided by h.
     std::vector<double> vNext(static_cast<std::size_t>(dimension_));
-    variationalVelocityUpdate(coefficients_, dimension_, v_.data(), gradient, vNext.data());
+    if (g) {
+      // The forced update from q_{k-1} = q_k - h v_{k-1}: the same velocity form.
+      std::vector<double> before(static_cast<std::size_t>(dimension_));
+      for (int a = 0; a < dimension_; ++a) before[a] = q_[a] - h * v_[a];
+      manoeuvreUpdate(coefficients_, *g, dimension_, before.data(), q_.data(), gradient, offset, next.data());
+      for (int a = 0; a < dimension_; ++a) vNext[a] = (next[a] - q_[a]) / h;
+    } else {
+      variationalVelocityUpdate(coefficients_, dimension_, v_.data(), gradient, vNext.data());
+    }
     for (int a = 0; a < dimension_; ++a) next[a] = q_[a] + h * vNext[a];
     v_.swap(vNext);
+  } else if (g) {
+    manoeuvreUpdate(coefficients_, *g, dimension_, qPrev_.data(), q_.data(), gradient, offset, next.data());
+    for (int a = 0; a < dimension_; ++a) v_[a] = (next[a] - q_[a]) / h;
   } else {
     // doc/maths.md §2, explicit update, as in VariationalIntegrator::step.
     variationalUpdate(coefficients_, dimension_, qPrev_.data(), q_.data(), gradient, next.data());

@@ -13,12 +13,8 @@ void AgentNode::onCommands(const ros::MessageEvent<variational_formation::Format
   const auto& list = event.getConstMessage()->commands;
   while (failure_.empty() && commandsHeld_ < static_cast<long>(list.size())) {
     const variational_formation::FormationCommand& m = list[static_cast<std::size_t>(commandsHeld_)];
-    Command c;
-    c.velocity = {m.velocity.x, m.velocity.y, m.velocity.z};
-    c.angularRate = {m.angular_rate.x, m.angular_rate.y, m.angular_rate.z};
-    c.scale = m.scale;
     std::string error;
-    const LockstepAgent::CommandReceipt receipt = agent_->receiveCommand(m.step, c, &error);
+    const LockstepAgent::CommandReceipt receipt = agent_->receiveCommand(m.step, commandOf(m), &error);
     if (receipt != LockstepAgent::CommandReceipt::Accepted) {
       // The monitor checked it and stamped it at a step no agent had passed: this cannot be made
       // exact any more, so the run ends, saying why.

@@ -45,7 +45,6 @@ LockstepMonitor::LockstepMonitor(ros::NodeHandle& nh, ros::NodeHandle& pnh) : Mo
   }
   recallServer_ = pnh.advertiseService("recall", &LockstepMonitor::onRecall, this);
   historyServer_ = pnh.advertiseService("history", &LockstepMonitor::onHistory, this);
-  setUpCommands(nh, pnh);
   announce(recorder_.node);
 }
 

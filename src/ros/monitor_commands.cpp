@@ -1,6 +1,6 @@
-// Live commands in a lockstep run (LockstepMonitor, monitor_node.hpp; doc/protocol.md
-// "Commands"): cmd_vel and scale in, checked by core's CommandDesk, which stamps them; the list
-// of issued commands out on the latched `command`, kept on the parameter server first.
+// Live commands (MonitorNode, monitor_node.hpp; doc/protocol.md "Commands"): cmd_vel and scale
+// in, checked by core's CommandDesk, which stamps them; the list of issued commands out on the
+// latched `command`, kept on the parameter server first. When they are issued is the mode's.
 #include <sstream>
 
 #include "variational_formation/FormationCommands.h"
@@ -14,7 +14,8 @@ namespace vf {
 namespace {
 
 
-variational_formation::FormationCommands toMessage(const std::vector<protocol::IssuedCommand>& issued, double h) {
+variational_formation::FormationCommands toMessage(const std::vector<protocol::IssuedCommand>& issued,
+                                                   const ros::Time& stamp) {
   variational_formation::FormationCommands msg;
   for (const protocol::IssuedCommand& c : issued) {
     variational_formation::FormationCommand m;
@@ -28,13 +29,13 @@ variational_formation::FormationCommands toMessage(const std::vector<protocol::I
     m.scale = c.second.scale;
     msg.commands.push_back(m);
   }
-  if (!issued.empty()) msg.header.stamp = ros::Time(static_cast<double>(issued.back().first) * h);
+  msg.header.stamp = stamp;
   return msg;
 }
 
 }  // namespace
 
-void LockstepMonitor::setUpCommands(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+void MonitorNode::setUpCommands(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   pnh_ = pnh;
   desk_ = std::make_unique<protocol::CommandDesk>(scenario_);
   std::istringstream names(optionalParam<std::string>(pnh, "commanders", ""));
@@ -50,7 +51,7 @@ void LockstepMonitor::setUpCommands(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
           [this](const ros::MessageEvent<std_msgs::Float64 const>& e) { onScaleCommand(e); }));
 }
 
-bool LockstepMonitor::commanderAllowed(const std::string& sender, const char* topic) {
+bool MonitorNode::commanderAllowed(const std::string& sender, const char* topic) {
   if (commanders_.empty()) return true;
   for (const std::string& c : commanders_) {
     if (c == sender) return true;
@@ -59,13 +60,13 @@ bool LockstepMonitor::commanderAllowed(const std::string& sender, const char* to
   return false;
 }
 
-void LockstepMonitor::refuseCommand(const char* topic, const std::string& sender, const std::string& why) {
+void MonitorNode::refuseCommand(const char* topic, const std::string& sender, const std::string& why) {
   ++commandsRefused_;
   ROS_WARN_THROTTLE(1.0, "monitor: dropped a command on %s from %s: %s; %ld dropped so far", topic, sender.c_str(),
                     why.c_str(), commandsRefused_);
 }
 
-void LockstepMonitor::onVelocityCommand(const ros::MessageEvent<geometry_msgs::Twist const>& event) {
+void MonitorNode::onVelocityCommand(const ros::MessageEvent<geometry_msgs::Twist const>& event) {
   const std::string sender = event.getPublisherName();
   if (ended() || !commanderAllowed(sender, "cmd_vel")) return;
   const geometry_msgs::Twist& t = *event.getConstMessage();
@@ -74,10 +75,10 @@ void LockstepMonitor::onVelocityCommand(const ros::MessageEvent<geometry_msgs::T
     refuseCommand("cmd_vel", sender, why);
     return;
   }
-  updateProgress();
+  commandOffered();
 }
 
-void LockstepMonitor::onScaleCommand(const ros::MessageEvent<std_msgs::Float64 const>& event) {
+void MonitorNode::onScaleCommand(const ros::MessageEvent<std_msgs::Float64 const>& event) {
   const std::string sender = event.getPublisherName();
   if (ended() || !commanderAllowed(sender, "scale")) return;
   std::string why;
@@ -85,10 +86,14 @@ void LockstepMonitor::onScaleCommand(const ros::MessageEvent<std_msgs::Float64 c
     refuseCommand("scale", sender, why);
     return;
   }
-  updateProgress();
+  commandOffered();
 }
 
-long LockstepMonitor::issueCommands(long allowedStep) {
+void MonitorNode::publishCommands() {
+  commandPub_.publish(toMessage(desk_->issued(), stampOf(desk_->issued().back().first)));
+}
+
+long MonitorNode::issueCommands(long allowedStep) {
   if (desk_->issue(allowedStep)) {
     // Kept before any agent can have it: a monitor that restarts goes on from the whole list.
     std::ostringstream kept;
@@ -96,7 +101,7 @@ long LockstepMonitor::issueCommands(long allowedStep) {
     for (const protocol::IssuedCommand& c : desk_->issued()) issued.add(c.first, c.second);
     writeCommands(kept, issued);
     pnh_.setParam("commands", kept.str());
-    commandPub_.publish(toMessage(desk_->issued(), scenario_.timeStep));
+    publishCommands();
     const protocol::IssuedCommand& c = desk_->issued().back();
     ROS_INFO("monitor: command %zu from step %ld: v* (%g, %g, %g) m/s, w* (%g, %g, %g) rad/s, s %g",
              desk_->issued().size(), c.first, c.second.velocity.x(), c.second.velocity.y(), c.second.velocity.z(),
@@ -106,7 +111,7 @@ long LockstepMonitor::issueCommands(long allowedStep) {
   return commandsIssued_;
 }
 
-void LockstepMonitor::resumeCommands(bool resumed) {
+void MonitorNode::resumeCommands(bool resumed) {
   std::string kept;
   if (!resumed) {
     pnh_.deleteParam("commands");  // an earlier run's
@@ -121,7 +126,7 @@ void LockstepMonitor::resumeCommands(bool resumed) {
     }
   }
   commandsIssued_ = static_cast<long>(desk_->issued().size());
-  if (!desk_->issued().empty()) commandPub_.publish(toMessage(desk_->issued(), scenario_.timeStep));
+  if (!desk_->issued().empty()) publishCommands();
 }
 
 }  // namespace vf

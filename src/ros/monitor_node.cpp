@@ -77,6 +77,7 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh, bool timed) 
   progress_.completed_step = -1;
   progress_.allowed_step = 0;
   progress_.converged_step = -1;
+  setUpCommands(nh, pnh);
 }
 
 void MonitorNode::announce(const std::string& recorder) const {

@@ -100,6 +100,14 @@ std::string framePrefix(const ros::NodeHandle& nh) {
   return ns.empty() ? "" : ns + "/";
 }
 
+Command commandOf(const variational_formation::FormationCommand& m) {
+  Command c;
+  c.velocity = {m.velocity.x, m.velocity.y, m.velocity.z};
+  c.angularRate = {m.angular_rate.x, m.angular_rate.y, m.angular_rate.z};
+  c.scale = m.scale;
+  return c;
+}
+
 std::string worldFrame(const ros::NodeHandle& pnh) {
   std::string key, frame = "world";
   if (pnh.searchParam("world_frame", key) && !pnh.getParam(key, frame)) {

@@ -44,13 +44,7 @@ void RecorderNode::onCommands(const ros::MessageEvent<variational_formation::For
 void RecorderNode::writeCommandsFile() const {
   if (commandsFile_.empty()) return;
   std::vector<protocol::IssuedCommand> issued;
-  for (const auto& m : commands_.commands) {
-    Command c;
-    c.velocity = {m.velocity.x, m.velocity.y, m.velocity.z};
-    c.angularRate = {m.angular_rate.x, m.angular_rate.y, m.angular_rate.z};
-    c.scale = m.scale;
-    issued.emplace_back(m.step, c);
-  }
+  for (const auto& m : commands_.commands) issued.emplace_back(m.step, commandOf(m));
   const CommandSchedule schedule = protocol::appliedSchedule(scenario_, issued);
   if (schedule.empty()) return;  // no manoeuvre and no command: nothing to replay
   // Written beside and renamed over: a reader never sees half a file.

@@ -56,6 +56,10 @@ TimedAgentNode::TimedAgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
       [this](const ros::MessageEvent<RunProgress const>& e) { onProgress(e); }, subs_, progressSub_);
   worldFrame_ = worldFrame(pnh);
   if (robot_) setUpRobot(nh, pnh, scenario, id);
+  commandSub_ = nh.subscribe<variational_formation::FormationCommands>(
+      "command", 10,
+      boost::function<void(const ros::MessageEvent<variational_formation::FormationCommands const>&)>(
+          [this](const ros::MessageEvent<variational_formation::FormationCommands const>& e) { onCommands(e); }));
   recallServer_ = nh.advertiseService(name_ + "/recall", &TimedAgentNode::onRecall, this);
   // The server starts from ~kappa: the scenario's (an earlier value would be another run's).
   pnh.setParam("kappa", scenario.dampingGain);
@@ -116,6 +120,21 @@ void TimedAgentNode::onProgress(const ros::MessageEvent<RunProgress const>& even
     running_ = true;
     ROS_INFO("%s: the monitor started the run; ticking every %g s from step %ld", name_.c_str(), h_ / rate_,
              agent_->step());
+  }
+}
+
+void TimedAgentNode::onCommands(const ros::MessageEvent<variational_formation::FormationCommands const>& event) {
+  const auto& list = event.getConstMessage()->commands;
+  if (!fromOwner(event, monitor_)) {
+    drop("a command list from " + event.getPublisherName() + ", which is not the monitor " + monitor_);
+  } else if (list.size() != commandsSeen_ && !list.empty()) {
+    try {
+      agent_->setCommand(commandOf(list.back()));
+      commandsSeen_ = list.size();
+      ROS_INFO("%s: command %zu from the next tick (step %ld on)", name_.c_str(), list.size(), agent_->step() + 1);
+    } catch (const InvalidInput& e) {
+      drop(std::string("a command: ") + e.what());
+    }
   }
 }
 

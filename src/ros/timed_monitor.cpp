@@ -1,3 +1,5 @@
+#include <algorithm>
+
 #include "variational_formation/core/number_checks.hpp"
 #include "variational_formation/ros/monitor_node.hpp"
 #include "variational_formation/ros/parameters.hpp"
@@ -26,7 +28,15 @@ bool TimedMonitor::offer(int agent, const AgentState& msg, const std::string& pu
   return true;
 }
 
+void TimedMonitor::commandOffered() {
+  // Stamped with the monitor's tick (after the last issued one); the agents take the newest.
+  long step = completedStep() + 1;
+  if (!desk_->issued().empty()) step = std::max(step, desk_->issued().back().first + 1);
+  issueCommands(step);
+}
+
 void TimedMonitor::begin() {
+  resumeCommands(false);  // agents keep the command they have; a new one replaces it
   tickTimer_ = nh_.createWallTimer(ros::WallDuration(scenario_.timeStep / rate_),
                                    [this](const ros::WallTimerEvent&) { tick(); });
   ROS_INFO("monitor: timed mode: status every %g s from each agent's newest state; the Noether predictions do "

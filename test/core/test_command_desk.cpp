@@ -46,14 +46,23 @@ TEST(CommandDesk, RefusesBadCommandsSayingWhy) {
 }
 
 TEST(CommandDesk, RefusesTurningAFormationThatCannotTurn) {
-  // A triangle with one edge missing is not rigid: agents cannot know their offsets.
-  Scenario s = loadScenario(test::configPath("square"));
+  // Agent 3 hangs on one edge: it cannot know its offset from the centroid, so the formation
+  // may translate and scale but not turn.
+  Scenario s = hexagon(100);
+  Positions shape(2, 4);
+  shape << 0, 1, 0, 1.2, 0, 0, 1, 0.7;
+  s.desiredPositions = shape;
+  s.initialPositions = shape;
+  s.initialVelocities = Velocities::Zero(2, 4);
+  s.edges = {{0, 1}, {1, 2}, {2, 0}, {3, 0}};
   CommandDesk desk(s);
   std::string why;
-  const bool turns = desk.offerVelocity({0, 0, 0}, {0, 0, 0.3}, why);
-  // The square qualifies or not; either way a refusal names the field and says why.
-  if (!turns) EXPECT_EQ(why.rfind("angular_rate: ", 0), 0u) << why;
+  EXPECT_FALSE(desk.offerVelocity({0, 0, 0}, {0, 0, 0.3}, why));
+  EXPECT_EQ(why.rfind("angular_rate: ", 0), 0u) << why;
+  EXPECT_NE(why.find("agent 3"), std::string::npos) << why;
+  EXPECT_FALSE(desk.pending());
   EXPECT_TRUE(desk.offerVelocity({0.2, 0, 0}, {0, 0, 0}, why)) << why;
+  EXPECT_TRUE(desk.offerScale(1.5, why)) << why;
 }
 
 TEST(CommandDesk, StampsAtTheAllowedStepOncePerStepAndMergesWhatWaits) {

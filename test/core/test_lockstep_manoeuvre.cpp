@@ -25,14 +25,7 @@ using test::command;
 // own between (entry step - 40) and the entry step. Compares every q_k with `expected`.
 void runDistributed(const Scenario& s, const CommandSchedule& broadcast, const CommandSchedule& expectedSchedule,
                     unsigned seed) {
-  const Formation f = makeFormation(s);
-  ManoeuvreIntegrator reference(f, s.initialPositions, s.initialVelocities, s.timeStep, s.dampingGain,
-                                StartMethod::Variational, expectedSchedule);
-  std::vector<Positions> expected{reference.positions()};
-  for (long k = 0; k < s.steps; ++k) {
-    reference.step();
-    expected.push_back(reference.positions());
-  }
+  const std::vector<Positions> expected = test::manoeuvreTrajectory(s, expectedSchedule);
   std::mt19937 rng(seed);
   std::vector<LockstepAgent> agents;
   std::vector<std::vector<long>> deliverAt(static_cast<std::size_t>(s.agentCount()));

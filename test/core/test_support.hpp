@@ -3,7 +3,10 @@
 
 #include <string>
 
+#include <vector>
+
 #include "variational_formation/core/manoeuvre_command.hpp"
+#include "variational_formation/core/manoeuvre_integrator.hpp"
 #include "variational_formation/core/scenario.hpp"
 
 namespace vf {
@@ -35,6 +38,19 @@ inline Command command(const Vector3& velocity, const Vector3& angularRate, doub
   c.angularRate = angularRate;
   c.scale = scale;
   return c;
+}
+
+/// q_0 .. q_steps of the centralised run of `s` under `schedule` (ManoeuvreIntegrator).
+inline std::vector<Positions> manoeuvreTrajectory(const Scenario& s, const CommandSchedule& schedule) {
+  const Formation f = makeFormation(s);  // the integrator keeps a reference to it
+  ManoeuvreIntegrator reference(f, s.initialPositions, s.initialVelocities, s.timeStep, s.dampingGain,
+                                StartMethod::Variational, schedule);
+  std::vector<Positions> trajectory{reference.positions()};
+  for (long k = 0; k < s.steps; ++k) {
+    reference.step();
+    trajectory.push_back(reference.positions());
+  }
+  return trajectory;
 }
 
 }  // namespace test

@@ -8,6 +8,7 @@
 
 #include "test_support.hpp"
 #include "variational_formation/core/error.hpp"
+#include "variational_formation/core/manoeuvre_integrator.hpp"
 #include "variational_formation/core/point_robot.hpp"
 #include "variational_formation/core/random.hpp"
 #include "variational_formation/core/timed_agent.hpp"
@@ -77,6 +78,52 @@ TEST(TimedAgent, FreshNeighboursReproduceTheCentralisedRunBitForBit) {
     expectSynchronousRunEquals(agents, reference(s), name);
     EXPECT_EQ(agents[0].dropped(), 0);
   }
+}
+
+TEST(TimedAgent, ACommandAtTheNextTickIsTheCentralisedRunUnderThatCommandBitForBit) {
+  Scenario s = loadScenario(test::configPath("hexagon_manoeuvre"));
+  s.manoeuvre.clear();
+  s.steps = 400;
+  const Command c = test::command({0.4, -0.2, 0}, {0, 0, 0.3}, 1.3);
+  // Set before the first tick: from step 0 on.
+  CommandSchedule fromStart;
+  fromStart.add(0, c);
+  std::vector<TimedAgent> agents = makeAgents(s);
+  for (TimedAgent& a : agents) a.setCommand(c);
+  EXPECT_EQ(agents[0].command(), c);
+  expectSynchronousRunEquals(agents, test::manoeuvreTrajectory(s, fromStart), "command from step 0");
+  // Set after tick 150: from step 150 on (the node gains join the two commands there).
+  CommandSchedule later;
+  later.add(150, c);
+  const std::vector<Positions> expected = test::manoeuvreTrajectory(s, later);
+  std::vector<TimedAgent> second = makeAgents(s);
+  expectSynchronousRunEquals(second, {expected.begin(), expected.begin() + 151}, "before the command");
+  for (TimedAgent& a : second) a.setCommand(c);
+  const double period = second[0].timeStep();
+  for (std::size_t k = 151; k < expected.size(); ++k) {
+    exchange(second, static_cast<double>(k - 1) * period);
+    for (TimedAgent& a : second) a.tick(static_cast<double>(k) * period);
+    for (const TimedAgent& a : second) {
+      for (int d = 0; d < 2; ++d) ASSERT_EQ(a.position()[d], expected[k](d, a.id())) << "step " << k;
+    }
+  }
+}
+
+TEST(TimedAgent, TheScenarioManoeuvreRunsByTheAgentsOwnStepUntilACommandReplacesIt) {
+  Scenario s = loadScenario(test::configPath("hexagon_manoeuvre"));
+  s.steps = 900;
+  std::vector<TimedAgent> agents = makeAgents(s);
+  expectSynchronousRunEquals(agents, test::manoeuvreTrajectory(s, scheduleFromSegments(s.manoeuvre, s.timeStep)),
+                             "hexagon_manoeuvre");
+}
+
+TEST(TimedAgent, BadCommandsAreRefusedAndLeaveTheCommand) {
+  Scenario s = loadScenario(test::configPath("hexagon"));
+  TimedAgent a(s, 0, kMaxAge);
+  EXPECT_THROW(a.setCommand(test::command({NAN, 0, 0}, {0, 0, 0}, 1.0)), InvalidInput);
+  EXPECT_THROW(a.setCommand(test::command({0, 0, 1.0}, {0, 0, 0}, 1.0)), InvalidInput);
+  EXPECT_THROW(a.setCommand(test::command({0, 0, 0}, {0, 0, 0}, 0.0)), InvalidInput);
+  EXPECT_EQ(a.command(), Command{});
 }
 
 TEST(TimedAgent, DampingGainSetBeforeTheRunGivesThatRunBitForBit) {

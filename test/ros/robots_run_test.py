@@ -31,6 +31,7 @@ import rosbag
 import rospy
 import rostest
 from diagnostic_msgs.msg import DiagnosticArray
+from variational_formation.msg import FormationStatus
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import vf_rostest  # noqa: E402
@@ -62,10 +63,26 @@ class RobotsRun(unittest.TestCase):
         cls.lag = float(rospy.get_param("~lag"))
         cls.expect_lag_warning = rospy.get_param("~expect_lag_warning")
         cls.world_frame = rospy.get_param("~world_frame")
+        # "vx_vy": a velocity command 2 s into the run and a stop 6.5 s later (empty: none).
+        cls.command = [float(x) for x in str(rospy.get_param("~command", "")).replace("_", " ").split()]
         cls.frames = set()  # (parent, child) of every transform; (frame, topic) of every other header
         cls.scenario = vf_rostest.load_scenario(cls.path)
         name = os.path.basename(cls.path).replace(".yaml", "")
         steps, h = cls.scenario["steps"], cls.scenario["time_step"]
+        if cls.command:
+            steering = vf_rostest.Steering("/formation", cls.scenario["n"])
+            status = []
+            sub = rospy.Subscriber("/formation/status", FormationStatus, lambda m: status.append(m.step), queue_size=100)
+            while not status or status[-1] < 140:
+                time.sleep(0.01)
+            steering.send(*cls.command)
+            cls.sent_at = rospy.Time.now().to_sec()
+            while status[-1] < 600:
+                time.sleep(0.01)
+            steering.send(0.0, 0.0)
+            cls.stopped_at = rospy.Time.now().to_sec()
+            sub.unregister()
+            steering.close()
         cls.result = vf_rostest.wait_for_result(os.path.join(cls.out, name + ".result.yaml"), steps * h + 30.0)
         # Stop the recorder (rosnode kill: a clean shutdown) so that the bag is closed and indexed.
         subprocess.run(["rosnode", "kill", "/formation/recorder"], capture_output=True)
@@ -83,7 +100,7 @@ class RobotsRun(unittest.TestCase):
                 cls.check_stamps(topic, msg, t)
                 if topic.endswith("/odom"):
                     cls.odom.setdefault(topic, []).append((t.to_sec(), msg))
-                elif topic.endswith("/cmd_vel"):
+                elif topic.endswith("/cmd_vel") and "/robot_" in topic:  # not the formation's formation/cmd_vel
                     cls.cmd_vel.setdefault(topic, []).append(msg)
                 elif topic == "/formation/status":
                     cls.status.append((t.to_sec(), msg))
@@ -186,6 +203,29 @@ class RobotsRun(unittest.TestCase):
             self.assertIn(f"formation/agent_{i}", children)
         for topic, msgs in self.odom.items():
             self.assertEqual({m.child_frame_id for _, m in msgs}, {topic.replace("/odom", "/base_link")[1:]})
+
+    def test_robots_follow_a_commanded_velocity(self):
+        if not self.command:
+            self.assertFalse(hasattr(self, "sent_at"))  # nothing was sent
+            return
+        # The robots' centroid (hand points), from the odometry averaged over 0.5 s before the
+        # command and 2 s after the stop (the coast of 1/kappa and the robots' lag are over).
+        def centroid(t0, t1):
+            points = []
+            for i in range(self.n()):
+                window = [self.point(m) for t, m in self.odom[f"/formation/robot_{i}/odom"] if t0 <= t < t1]
+                points.append([sum(p[c] for p in window) / len(window) for c in range(2)])
+            return [sum(p[c] for p in points) / self.n() for c in range(2)]
+        before = centroid(self.sent_at - 0.5, self.sent_at)
+        after = centroid(self.stopped_at + 2.0, self.stopped_at + 2.5)
+        seconds = self.stopped_at - self.sent_at
+        moved = [b - a for a, b in zip(before, after)]
+        wanted = [v * seconds for v in self.command]
+        error = math.dist(moved, wanted)
+        print(f"robots ({self.kinematics}): commanded {self.command} m/s for {seconds:.2f} s: moved "
+              f"{[round(x, 3) for x in moved]} m, wanted {[round(x, 3) for x in wanted]} m "
+              f"({100 * error / math.hypot(*wanted):.1f}% off)", flush=True)
+        self.assertLess(error, 0.1 * math.hypot(*wanted))
 
     def test_commands_suit_the_kinematics(self):
         msgs = [m for v in self.cmd_vel.values() for m in v]

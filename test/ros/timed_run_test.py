@@ -12,6 +12,7 @@ Private parameters:
   output_dir  where the monitor writes its result file (removed after)
 Every case also checks each agent's /diagnostics (step rate near 1/h). It prints the convergence time: the first tick of the final congruent stretch times h / rate.
 """
+import math
 import os
 import shutil
 import signal
@@ -59,6 +60,8 @@ class TimedRun(unittest.TestCase):
         cls.victim = int(rospy.get_param("~kill", -1))
         cls.max_age = float(rospy.get_param("~max_age", 0.5))
         cls.kappa = float(rospy.get_param("~reconfigure_kappa", 0.0))
+        # "vx_vy": a velocity command 2 s into the run, and a stop 6.5 s later (empty: none).
+        cls.command = [float(x) for x in str(rospy.get_param("~command", "")).replace("_", " ").split()]
         cls.diagnostics = {}
 
         def on_diagnostics(msg):
@@ -102,6 +105,17 @@ class TimedRun(unittest.TestCase):
             for i in range(cls.scenario["n"]):
                 Client(f"{NS}/agent_{i}", timeout=5).update_configuration({"kappa": cls.kappa})
             print(f"kappa set to {cls.kappa} at tick {cls.status[-1][1].step}", flush=True)
+        if cls.command:
+            steering = vf_rostest.Steering(NS, cls.scenario["n"])
+            while not cls.status or cls.status[-1][1].step < 140:
+                time.sleep(0.01)
+            cls.sent_at, cls.from_centroid = time.monotonic(), steering.send(*cls.command)
+            while cls.status[-1][1].step < 600:
+                time.sleep(0.01)
+            cls.stopped_at, cls.to_centroid = time.monotonic(), steering.send(0.0, 0.0)
+            time.sleep(2.0)  # the coast after the stop: 1/kappa
+            cls.end_centroid = steering.centroid()
+            steering.close()
         name = os.path.basename(cls.path).replace(".yaml", "")
         cls.result = vf_rostest.wait_for_result(os.path.join(cls.out, name + ".result.yaml"), 50.0)
 
@@ -130,6 +144,20 @@ class TimedRun(unittest.TestCase):
             self.assertEqual(congruent[:5], [], "congruent beyond the delay margin")
             self.assertTrue(self.result.get("result") == "failed" or last.max_distance_error > 0.1,
                             f"result {self.result}, last max distance error {last.max_distance_error}")
+
+    def test_follows_a_commanded_velocity(self):
+        if not self.command:
+            self.assertFalse(hasattr(self, "sent_at"))  # nothing was sent: the run is the others'
+            return
+        # Timed agents apply the newest command at their next tick: the centroid moves at v*
+        # (after a transient of 1/kappa at each end, which cancels in the displacement).
+        seconds = self.stopped_at - self.sent_at
+        moved = [b - a for a, b in zip(self.from_centroid, self.end_centroid)]
+        wanted = [v * seconds for v in self.command]
+        error = math.dist(moved, wanted)
+        print(f"commanded {self.command} m/s for {seconds:.2f} s: the centroid moved {moved}, wanted {wanted} "
+              f"({100 * error / math.hypot(*wanted):.1f}% off)", flush=True)
+        self.assertLess(error, 0.1 * math.hypot(*wanted))
 
     def test_diagnostics(self):
         self.assertEqual(sorted(self.diagnostics), [f"agent_{i}" for i in range(self.scenario["n"])])

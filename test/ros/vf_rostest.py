@@ -13,6 +13,7 @@ import xmlrpc.client
 
 import rosbag
 import rosgraph
+import rospy
 import rospkg
 import yaml
 
@@ -233,3 +234,42 @@ class RunChecks:
                 scale = max(1.0, math.sqrt(pred.x ** 2 + pred.y ** 2 + pred.z ** 2))
                 err = math.sqrt((x.x - pred.x) ** 2 + (x.y - pred.y) ** 2 + (x.z - pred.z) ** 2)
                 self.assertLess(err / scale, 1e-9, f"step {k}")
+
+
+class Steering:
+    """Sends the formation in `ns` one velocity command and later a stop (zero Twist), as a
+    foreign node would (formation/cmd_vel), and notes the formation's centroid at both moments,
+    computed with the agents' states, to check how far it went."""
+
+    def __init__(self, ns, n):
+        from geometry_msgs.msg import Twist
+        from variational_formation.msg import AgentState
+        self.Twist = Twist
+        self.newest = {}
+        self.subs = [rospy.Subscriber(f"{ns}/agent_{i}/state", AgentState, self.on_state, queue_size=10)
+                     for i in range(n)]
+        self.n = n
+        self.pub = rospy.Publisher(f"{ns}/cmd_vel", Twist, queue_size=10)
+        end = time.time() + 30
+        while self.pub.get_num_connections() == 0 and time.time() < end:
+            time.sleep(0.05)
+        assert self.pub.get_num_connections(), f"nobody subscribes to {ns}/cmd_vel"
+
+    def on_state(self, msg):
+        self.newest[msg.id] = list(msg.position)
+
+    def centroid(self):
+        assert len(self.newest) == self.n, f"states of {sorted(self.newest)} only"
+        points = list(self.newest.values())
+        return [sum(p[c] for p in points) / self.n for c in range(len(points[0]))]
+
+    def send(self, vx, vy, wz=0.0):
+        t = self.Twist()
+        t.linear.x, t.linear.y, t.angular.z = vx, vy, wz
+        self.pub.publish(t)
+        return self.centroid()
+
+    def close(self):
+        for s in self.subs:
+            s.unregister()
+

@@ -2,6 +2,7 @@
 
 #include <vector>
 
+#include "variational_formation/core/motion_parameters.hpp"
 #include "variational_formation/core/scenario.hpp"
 
 namespace vf {
@@ -47,12 +48,34 @@ class AgentNeighbourhood {
     formation_.agentGradient(id_, view_, out);
   }
 
+  /**
+   * Under a command (doc/maths.md §9): grad_i V_s with s^2 = scaleSquared into `gradient`, and,
+   * if `rotates`, the agent's centroid offset r_i into `offset` (d doubles each), from the same
+   * positions as gradient().
+   */
+  template <class NeighbourPosition>
+  void forcedGradient(const double* own, NeighbourPosition neighbourPosition, double scaleSquared, bool rotates,
+                      double* gradient, double* offset) {
+    const int d = dimension();
+    for (int a = 0; a < d; ++a) view_(a, id_) = own[a];
+    for (int j : neighbourIds_) {
+      const double* qj = neighbourPosition(j);
+      for (int a = 0; a < d; ++a) view_(a, j) = qj[a];
+    }
+    formation_.agentScaledGradient(id_, view_, scaleSquared, gradient);
+    if (rotates) centroidOffset(formation_, motion_, id_, view_, offset);
+  }
+  /// Whether this agent knows its offset from the centroid from its neighbours (it can turn),
+  /// and if not, why.
+  const MotionParameters& motion() const { return motion_; }
+
  private:
   Formation formation_;
   int id_;
   std::vector<int> neighbourIds_;
   std::vector<double> q0_, v0_;
   Positions view_;  // positions of self and neighbours, d x n (other columns unused)
+  MotionParameters motion_;
 };
 
 }  // namespace vf

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "variational_formation/core/agent_neighbourhood.hpp"
+#include "variational_formation/core/manoeuvre.hpp"
 #include "variational_formation/core/scenario.hpp"
 #include "variational_formation/core/variational_update.hpp"
 
@@ -80,6 +81,17 @@ class TimedAgent {
   void setMeasuredPosition(const std::vector<double>& position);
 
   /**
+   * A commanded motion (v*, omega*, s; doc/manoeuvres.md) from the next tick on, replacing the
+   * scenario's `manoeuvre:` (which otherwise applies by the agent's own step). The update is the
+   * forced one of doc/maths.md §9 with the node gains of the previous tick's command and this one.
+   * @throws InvalidInput if validateCommand refuses it or it turns and this agent cannot know its
+   * offset from the centroid; the agent's command is then unchanged.
+   */
+  void setCommand(const Command& command);
+  /// The command of the coming tick (zero without any).
+  Command command() const;
+
+  /**
    * kappa [1/s] (dynamic_reconfigure): recomputes the update coefficients; the velocity state
    * is kept. @throws InvalidInput if kappa is not finite and >= 0.
    */
@@ -134,7 +146,8 @@ class TimedAgent {
   Receipt accept(long sender, long step, const std::vector<double>& position,
                  const std::vector<double>& previousPosition, double now);
   void hold();
-  void move(const double* gradient);
+  /// The update (or start) with the gradient and, under a command, the forcing `g` and offset.
+  void move(const double* gradient, const ManoeuvreGains* g, const double* offset);
 
   AgentNeighbourhood neighbourhood_;
   VariationalCoefficients coefficients_;
@@ -152,6 +165,11 @@ class TimedAgent {
   long dropped_ = 0;
   std::vector<double> qPrev_, q_, v_, qMeasured_;
   std::vector<NeighbourState> neighbours_;  // indexed by agent id (only neighbours used)
+  CommandSchedule schedule_;  // the scenario's manoeuvre (empty: none)
+  bool live_ = false;         // a command came: it applies instead of the schedule
+  Command liveCommand_;
+  bool haveLastGains_ = false;  // the previous move's interval gains (for the node gains)
+  ManoeuvreGains lastGains_;
 };
 
 }  // namespace vf

@@ -74,7 +74,27 @@ class MonitorNode {
   /// /clock need it), ROS time now in timed mode (robots and tf consumers live in it).
   virtual ros::Time stampOf(long step) const = 0;
   /// The commanded motion the agents apply (the markers follow it), or nullptr without one.
-  virtual const CommandSchedule* commandSchedule() const { return nullptr; }
+  const CommandSchedule* commandSchedule() const {
+    return desk_->schedule().empty() ? nullptr : &desk_->schedule();
+  }
+  /// A good command is pending in desk_: the mode issues it (lockstep at the allowed step, timed
+  /// at once).
+  virtual void commandOffered() = 0;
+
+  // Live commands (src/ros/monitor_commands.cpp, doc/protocol.md "Commands").
+  void setUpCommands(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  void onVelocityCommand(const ros::MessageEvent<geometry_msgs::Twist const>& event);
+  void onScaleCommand(const ros::MessageEvent<std_msgs::Float64 const>& event);
+  /// A command from a sender not in ~commanders is refused (empty: anyone may command).
+  bool commanderAllowed(const std::string& sender, const char* topic);
+  void refuseCommand(const char* topic, const std::string& sender, const std::string& why);
+  /// Issues what is pending at `step`, keeps the list on the parameter server, publishes it;
+  /// @return the number of issued commands, for the progress.
+  long issueCommands(long step);
+  /// A new run forgets an earlier run's commands; a resumed one goes on from the kept list.
+  void resumeCommands(bool resumed);
+  /// The issued list on `command`, stamped as the mode stamps what it says (stampOf).
+  void publishCommands();
 
   /// Publishes one completed step's status and markers (and /clock), stamped `stamp`; tracks the
   /// congruent stretch for the result. @return what was published, for the recorder gate.
@@ -109,7 +129,12 @@ class MonitorNode {
   ros::WallTime firstStepAt_, lastCompletedAt_, lastReportAt_, startedAt_;
   long reportedConvergence_ = -2;  // the congruent stretch already announced (-2: none)
   long convergedStep_ = -1;        // first step of the congruent stretch at the newest step (-1: none)
-  long commandsIssued_ = 0, commandsRefused_ = 0;  // live commands (lockstep), for the result file
+  long commandsIssued_ = 0, commandsRefused_ = 0;  // live commands, for the result file
+  std::unique_ptr<protocol::CommandDesk> desk_;
+  ros::NodeHandle pnh_;
+  ros::Subscriber velocityCommandSub_, scaleCommandSub_;
+  ros::Publisher commandPub_;
+  std::vector<std::string> commanders_;  // full node names; empty: anyone
 
  private:
   void writeResult(const std::string& result, const std::string& reason) const;
@@ -152,21 +177,7 @@ class LockstepMonitor : public MonitorNode {
   long completedStep() const override { return referee_->completedStep(); }
   const FormationMonitor& measure() const override { return referee_->monitor(); }
   ros::Time stampOf(long step) const override { return ros::Time(std::max(0L, step) * scenario_.timeStep); }
-  const CommandSchedule* commandSchedule() const override {
-    return desk_->schedule().empty() ? nullptr : &desk_->schedule();
-  }
-  // Live commands (src/ros/monitor_commands.cpp, doc/protocol.md "Commands").
-  void setUpCommands(ros::NodeHandle& nh, ros::NodeHandle& pnh);
-  void onVelocityCommand(const ros::MessageEvent<geometry_msgs::Twist const>& event);
-  void onScaleCommand(const ros::MessageEvent<std_msgs::Float64 const>& event);
-  /// A command from a sender not in ~commanders is refused (empty: anyone may command).
-  bool commanderAllowed(const std::string& sender, const char* topic);
-  void refuseCommand(const char* topic, const std::string& sender, const std::string& why);
-  /// Issues what is pending at `allowedStep`, keeps the list on the parameter server, publishes
-  /// it; @return the number of issued commands, for the progress.
-  long issueCommands(long allowedStep);
-  /// A new run forgets an earlier run's commands; a resumed one goes on from the kept list.
-  void resumeCommands(bool resumed);
+  void commandOffered() override { updateProgress(); }  // issued at the allowed step, then counted
   void onRecorderProgress(const ros::MessageEvent<RunProgress const>& event);
   bool onRecall(RecallState::Request& request, RecallState::Response& response);
   bool onHistory(RecallHistory::Request& request, RecallHistory::Response& response);
@@ -181,11 +192,6 @@ class LockstepMonitor : public MonitorNode {
   Participant recorder_;
   ros::Subscriber recorderSub_;
   ros::ServiceServer recallServer_, historyServer_;
-  std::unique_ptr<protocol::CommandDesk> desk_;
-  ros::NodeHandle pnh_;
-  ros::Subscriber velocityCommandSub_, scaleCommandSub_;
-  ros::Publisher commandPub_;
-  std::vector<std::string> commanders_;  // full node names; empty: anyone
 };
 
 /**
@@ -207,6 +213,8 @@ class TimedMonitor : public MonitorNode {
   long completedStep() const override { return referee_->completedStep(); }
   const FormationMonitor& measure() const override { return referee_->monitor(); }
   ros::Time stampOf(long) const override { return ros::Time::now(); }
+  /// Timed agents apply the newest command at their next tick: issued at once.
+  void commandOffered() override;
   void tick();
 
   std::unique_ptr<protocol::TimedReferee<AgentState>> referee_;

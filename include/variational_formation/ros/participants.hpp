@@ -7,6 +7,9 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <ros/ros.h>
 
+#include "variational_formation/FormationCommand.h"
+#include "variational_formation/core/manoeuvre_command.hpp"
+
 #include "variational_formation/AgentState.h"
 #include "variational_formation/RecallState.h"
 #include "variational_formation/RunProgress.h"
@@ -28,6 +31,9 @@ std::string framePrefix(const ros::NodeHandle& nh);
  * @throws InvalidInput on an empty name or one with spaces.
  */
 std::string worldFrame(const ros::NodeHandle& pnh);
+
+/// The command of a FormationCommand message (its step aside).
+Command commandOf(const variational_formation::FormationCommand& message);
 
 /// The tf of a frame `child` at position (x, y, z) of header.frame_id, not rotated: the one
 /// place that builds an agent's or a robot's transform.

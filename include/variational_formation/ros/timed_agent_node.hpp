@@ -12,6 +12,7 @@
 #include <tf2_ros/transform_broadcaster.h>
 
 #include "variational_formation/AgentState.h"
+#include "variational_formation/FormationCommands.h"
 #include "variational_formation/RecallState.h"
 #include "variational_formation/RunProgress.h"
 #include "variational_formation/TimedAgentConfig.h"
@@ -66,6 +67,8 @@ class TimedAgentNode {
   void onNeighbourState(int neighbour, const ros::MessageEvent<AgentState const>& event);
   void onProgress(const ros::MessageEvent<RunProgress const>& event);
   void onOdometry(const nav_msgs::Odometry& odom);
+  /// The monitor's issued commands: the newest applies from the next tick.
+  void onCommands(const ros::MessageEvent<variational_formation::FormationCommands const>& event);
   void onTick();
   void publish();
   void sendCommand();
@@ -85,7 +88,8 @@ class TimedAgentNode {
   std::vector<ros::Subscriber> subs_;
   std::vector<std::string> neighbourOwners_;  // full node names, indexed like neighbourIds()
   std::map<int, AgentState> newest_;          // each neighbour's newest accepted state, for ~recall
-  ros::Subscriber progressSub_, odomSub_;
+  ros::Subscriber progressSub_, odomSub_, commandSub_;
+  std::size_t commandsSeen_ = 0;
   ros::ServiceServer recallServer_;
   std::string monitor_;
   tf2_ros::TransformBroadcaster tf_;
