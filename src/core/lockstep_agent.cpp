@@ -9,26 +9,15 @@ namespace vf {
 
 LockstepAgent::LockstepAgent(const Scenario& scenario, int id, StartMethod start)
     : scenario_(scenario),
-      formation_(makeFormation(scenario)),
+      neighbourhood_(scenario, id),  // checks the id
       coefficients_(scenario.timeStep, scenario.dampingGain),
       start_(start),
       id_(id),
       dimension_(scenario.dimension) {
-  const int n = formation_.agentCount();
-  if (id < 0 || id >= n) {
-    throw InvalidInput("id: must be an agent id 0.." + std::to_string(n - 1) + ", got " +
-                       std::to_string(id));
-  }
-  q_.assign(scenario.initialPositions.col(id).data(),
-            scenario.initialPositions.col(id).data() + dimension_);
+  q_ = neighbourhood_.initialPosition();
   qPrev_ = q_;
   qBeforePrev_ = q_;
-  v0_.assign(scenario.initialVelocities.col(id).data(),
-             scenario.initialVelocities.col(id).data() + dimension_);
-  for (const Neighbour& nb : formation_.neighbours(id)) neighbourIds_.push_back(nb.agent);
-  neighbours_.resize(static_cast<std::size_t>(n));
-  neighbourhoodPositions_ = Positions::Zero(dimension_, n);
-  motionParameters_ = motionParameters(formation_, id);
+  neighbours_.resize(static_cast<std::size_t>(scenario.agentCount()));
   if (!scenario.manoeuvre.empty()) {
     manoeuvre_ = std::make_unique<ManoeuvreModel>(coefficients_,
                                                   scheduleFromSegments(scenario.manoeuvre, scenario.timeStep));
@@ -45,8 +34,8 @@ LockstepAgent::CommandReceipt LockstepAgent::receiveCommand(long step, const Com
     if (error) *error = e.what();
     return CommandReceipt::Invalid;
   }
-  if (command.rotates() && !motionParameters_.exact) {
-    if (error) *error = motionParameters_.problem;
+  if (command.rotates() && !neighbourhood_.motion().exact) {
+    if (error) *error = neighbourhood_.motion().problem;
     return CommandReceipt::CannotTurn;
   }
   if (!manoeuvre_) manoeuvre_ = std::make_unique<ManoeuvreModel>(coefficients_, CommandSchedule{});
@@ -74,15 +63,11 @@ std::string LockstepAgent::describe(Receipt receipt) {
 LockstepAgent::Receipt LockstepAgent::receive(long sender, long step,
                                               const std::vector<double>& position,
                                               const std::vector<double>& previousPosition) {
-  bool isNeighbour = false;
-  for (int j : neighbourIds_) isNeighbour = isNeighbour || j == sender;
-  if (!isNeighbour) return Receipt::UnknownSender;
-  if (static_cast<int>(position.size()) != dimension_ ||
-      static_cast<int>(previousPosition.size()) != dimension_) {
-    return Receipt::WrongDimension;
-  }
-  for (int a = 0; a < dimension_; ++a) {
-    if (!std::isfinite(position[a]) || !std::isfinite(previousPosition[a])) return Receipt::NonFinite;
+  switch (neighbourhood_.check(sender, position, previousPosition)) {
+    case AgentNeighbourhood::StateCheck::UnknownSender: return Receipt::UnknownSender;
+    case AgentNeighbourhood::StateCheck::WrongDimension: return Receipt::WrongDimension;
+    case AgentNeighbourhood::StateCheck::NonFinite: return Receipt::NonFinite;
+    case AgentNeighbourhood::StateCheck::Usable: break;
   }
   NeighbourState& held = neighbours_[static_cast<std::size_t>(sender)];
   // A neighbour is at most one step ahead, and never goes back.
@@ -118,7 +103,7 @@ bool LockstepAgent::neighbourState(int j, long& step, std::vector<double>& posit
 }
 
 bool LockstepAgent::ready() const {
-  for (int j : neighbourIds_) {
+  for (int j : neighbourIds()) {
     if (!neighbourPositionAtStep(neighbours_[static_cast<std::size_t>(j)])) return false;
   }
   return true;
@@ -126,19 +111,16 @@ bool LockstepAgent::ready() const {
 
 void LockstepAgent::advance() {
   if (!ready()) throw InvalidInput("advance: a neighbour's state at step " + std::to_string(step_) + " is missing");
-  for (int a = 0; a < dimension_; ++a) neighbourhoodPositions_(a, id_) = q_[a];
-  for (int j : neighbourIds_) {
-    const double* qj = neighbourPositionAtStep(neighbours_[static_cast<std::size_t>(j)]);
-    for (int a = 0; a < dimension_; ++a) neighbourhoodPositions_(a, j) = qj[a];
-  }
   std::vector<double> next(static_cast<std::size_t>(dimension_));
   if (manoeuvre_) {
     manoeuvreStep(next.data());
   } else {
     double gradient[3];
-    formation_.agentGradient(id_, neighbourhoodPositions_, gradient);
-    variationalStep(coefficients_, start_, step_, dimension_, qPrev_.data(), q_.data(), v0_.data(), gradient,
-                    next.data());
+    neighbourhood_.gradient(
+        q_.data(), [this](int j) { return neighbourPositionAtStep(neighbours_[static_cast<std::size_t>(j)]); },
+        gradient);
+    variationalStep(coefficients_, start_, step_, dimension_, qPrev_.data(), q_.data(),
+                    neighbourhood_.initialVelocity().data(), gradient, next.data());
   }
   qBeforePrev_.swap(qPrev_);
   qPrev_.swap(q_);
@@ -148,17 +130,19 @@ void LockstepAgent::advance() {
 }
 
 // doc/maths.md §9, as in ManoeuvreIntegrator::step.
-void LockstepAgent::manoeuvreStep(double* next) const {
+void LockstepAgent::manoeuvreStep(double* next) {
   const ManoeuvreGains g = manoeuvre_->updateGains(step_);
   double gradient[3], offset[3] = {0.0, 0.0, 0.0};
-  formation_.agentScaledGradient(id_, neighbourhoodPositions_, g.scaleSquared, gradient);
-  if (g.rotates) centroidOffset(formation_, motionParameters_, id_, neighbourhoodPositions_, offset);
+  neighbourhood_.forcedGradient(
+      q_.data(), [this](int j) { return neighbourPositionAtStep(neighbours_[static_cast<std::size_t>(j)]); },
+      g.scaleSquared, g.rotates, gradient, offset);
   if (step_ > 0) {
     manoeuvreUpdate(coefficients_, g, dimension_, qPrev_.data(), q_.data(), gradient, offset, next);
   } else if (start_ == StartMethod::Variational) {
-    manoeuvreStart(coefficients_, g, dimension_, q_.data(), v0_.data(), gradient, offset, next);
+    manoeuvreStart(coefficients_, g, dimension_, q_.data(), neighbourhood_.initialVelocity().data(), gradient, offset,
+                   next);
   } else {
-    paperStart(coefficients_, dimension_, q_.data(), v0_.data(), next);
+    paperStart(coefficients_, dimension_, q_.data(), neighbourhood_.initialVelocity().data(), next);
   }
 }
 

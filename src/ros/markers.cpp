@@ -150,8 +150,8 @@ void addAgentsAndTrails(const FormationSnapshot& s, const std::vector<std::deque
   }
 }
 
-/// The edges, green (no error) to red (|error| >= 10% of d_ij), and the desired shape's edges
-/// as a faint ghost; nothing without edges.
+/// The edges, green (no error) to red (|error| >= 10% of s d_ij, s the commanded scale), and the
+/// desired shape's edges as a faint ghost; nothing without edges.
 void addEdgesAndGhostEdges(const FormationSnapshot& s, const Formation& formation, const Ghost& ghostAt,
                            double radius, const ros::Time& stamp, visualization_msgs::MarkerArray& out) {
   Marker edges = base("edges", 0, Marker::LINE_LIST, stamp);
@@ -162,8 +162,10 @@ void addEdgesAndGhostEdges(const FormationSnapshot& s, const Formation& formatio
   ghost.color = rgba(0.7, 0.7, 0.7, 0.35);
   for (std::size_t e = 0; e < formation.edges().size(); ++e) {
     const Edge& edge = formation.edges()[e];
-    const double badness = std::min(1.0, std::abs(s.edgeDistanceErrors(static_cast<long>(e))) /
-                                             (0.1 * std::max(edge.desiredDistance, 1e-9)));
+    // Against s d_ij under a commanded scale s (the status measures against d_ij).
+    const double wanted = ghostAt.frame.scale * edge.desiredDistance;
+    const double error = (column3(s.positions, edge.tail) - column3(s.positions, edge.head)).norm() - wanted;
+    const double badness = std::min(1.0, std::abs(error) / (0.1 * std::max(wanted, 1e-9)));
     const std_msgs::ColorRGBA c = rgba(badness, 1.0 - 0.8 * badness, 0.1, 1.0);
     for (int end : {edge.tail, edge.head}) {
       edges.points.push_back(point(column3(s.positions, end)));

@@ -11,17 +11,6 @@
 
 namespace vf {
 
-namespace {
-
-/// The default ~frame_prefix: "/robots/r0" -> "robots/r0/", "/" -> "".
-std::string namespacePrefix() {
-  std::string ns = ros::this_node::getNamespace();
-  while (!ns.empty() && ns.front() == '/') ns.erase(ns.begin());
-  return ns.empty() ? ns : ns + "/";
-}
-
-}  // namespace
-
 RobotSimNode::RobotSimNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   const int id = requiredParam<int>(pnh, "id");
   if (id < 0) throw InvalidInput("~id: must be >= 0, got " + std::to_string(id));
@@ -30,7 +19,8 @@ RobotSimNode::RobotSimNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   const std::string kinematics = optionalParam<std::string>(pnh, "kinematics", "holonomic");
   const int seed = optionalParam(pnh, "seed", id);
   cmdTimeout_ = optionalParam(pnh, "cmd_timeout", cmdTimeout_);
-  const std::string prefix = optionalParam(pnh, "frame_prefix", namespacePrefix());
+  // The default ~frame_prefix is the namespace: "/formation/robot_0" -> "formation/robot_0/".
+  const std::string prefix = optionalParam(pnh, "frame_prefix", framePrefix(nh));
   worldFrame_ = worldFrame(pnh);
   std::string described;
   try {

@@ -7,6 +7,8 @@
 #include <functional>
 #include <iostream>
 
+#include <Eigen/Geometry>
+
 #include "test_support.hpp"
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/manoeuvre_integrator.hpp"
@@ -477,6 +479,31 @@ TEST(ManoeuvreStability, AllowedMagnitudesHoldTheShape) {
 
 TEST(ManoeuvreStability, TurningFasterThanTheSoftestShapeModeLosesTheShape) {
   EXPECT_GT(finalEdgeError(4.0, 0.0, 4.0, 40.0), 1e-3);
+}
+
+TEST(CommandedFrame, TurnsByTheIntegratedRateAndTakesTheScaleAndVelocityOfTheStep) {
+  const double h = 0.01;
+  CommandSchedule schedule;
+  schedule.add(100, test::command({0.5, 0, 0}, {0, 0, 0.3}, 1.2));
+  schedule.add(300, test::command({0, -1, 0}, {0, 0, -0.1}, 0.8));
+  // Before the first entry: the zero command, no turn.
+  CommandedFrame f = commandedFrame(schedule, 50, h);
+  EXPECT_TRUE(f.rotation.isIdentity(0.0));
+  EXPECT_EQ(f.scale, 1.0);
+  EXPECT_TRUE(f.velocity.isZero(0.0));
+  // Intervals 100..299 at 0.3 rad/s, then 300..449 at -0.1 rad/s: 0.6 - 0.15 = 0.45 rad about z.
+  f = commandedFrame(schedule, 450, h);
+  EXPECT_NEAR(std::atan2(f.rotation(1, 0), f.rotation(0, 0)), 0.45, 1e-14);
+  EXPECT_NEAR(f.rotation(2, 2), 1.0, 1e-15);
+  EXPECT_EQ(f.scale, 0.8);
+  EXPECT_EQ(f.velocity, Vector3(0, -1, 0));
+  // In 3D, turns about different axes compose in order: R2 R1.
+  CommandSchedule spatial;
+  spatial.add(0, test::command({0, 0, 0}, {0.2, 0, 0}, 1.0));
+  spatial.add(10, test::command({0, 0, 0}, {0, 0.3, 0}, 1.0));
+  const Eigen::Matrix3d r1 = Eigen::AngleAxisd(0.2 * 10 * h, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const Eigen::Matrix3d r2 = Eigen::AngleAxisd(0.3 * 5 * h, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  EXPECT_TRUE(commandedFrame(spatial, 15, h).rotation.isApprox(r2 * r1, 1e-14));
 }
 
 }  // namespace

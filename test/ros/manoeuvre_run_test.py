@@ -25,6 +25,7 @@ import sys
 import time
 import unittest
 
+import rosbag
 import rospy
 import rostest
 import yaml
@@ -160,6 +161,40 @@ class ManoeuvreRun(unittest.TestCase, vf_rostest.RunChecks):
             row = next(r for r in rows if int(r[0]) == c.step)
             self.assertEqual([float(x) for x in row[1:]], [c.velocity.x, c.velocity.y, c.velocity.z, c.angular_rate.x,
                                                             c.angular_rate.y, c.angular_rate.z, c.scale])
+
+    def test_markers_show_the_command(self):
+        # The last step's markers: an arrow of v* from the centroid, and the ghost of the desired
+        # shape scaled by s (the file's last row governs the last step).
+        with open(self.commands_file) as f:
+            last = [float(x) for x in list(f)[-1].strip().split(",")]
+        velocity, s = last[1:4], last[7]
+        steps = int(self.scenario["steps"])
+        markers = None
+        with rosbag.Bag(self.bag) as bag:
+            for _, msg, t in bag.read_messages(topics=[f"{NS}/markers"]):
+                markers = msg  # the last one is the last step's
+        self.assertIsNotNone(markers, "no markers in the bag")
+        by_ns = {(m.ns, m.id): m for m in markers.markers}
+        rec = vf_rostest.Recording(self.bag)
+        n = self.scenario["n"]
+        centroid = [sum(rec.states[(i, steps)][0].position[c] for i in range(n)) / n for c in range(2)]
+        arrow = by_ns.get(("command", 0))
+        self.assertIsNotNone(arrow, sorted(by_ns))
+        if any(velocity):
+            self.assertEqual(arrow.type, arrow.ARROW)
+            self.assertAlmostEqual(arrow.points[0].x, centroid[0], delta=1e-9)
+            self.assertAlmostEqual(arrow.points[0].y, centroid[1], delta=1e-9)
+            self.assertAlmostEqual(arrow.points[1].x - arrow.points[0].x, velocity[0], delta=1e-9)
+            self.assertAlmostEqual(arrow.points[1].y - arrow.points[0].y, velocity[1], delta=1e-9)
+        else:
+            self.assertEqual(arrow.action, arrow.DELETE)
+        # Edges coloured by their error against s d_ij: the formation holds the scaled shape.
+        self.assertLess(max(c.r for c in by_ns[("edges", 0)].colors), 0.1)
+        ghost = by_ns[("desired_shape", 0)].points
+        desired = {a["id"]: a["desired_position"] for a in self.scenario["agents"]}
+        for e, (a, b) in enumerate(self.scenario["edges"]):
+            length = math.dist((ghost[2 * e].x, ghost[2 * e].y), (ghost[2 * e + 1].x, ghost[2 * e + 1].y))
+            self.assertAlmostEqual(length / (s * math.dist(desired[a], desired[b])), 1.0, delta=1e-9)
 
     def test_faults_were_injected(self):
         if self.faults:

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "variational_formation/core/manoeuvre.hpp"
+#include "variational_formation/core/agent_neighbourhood.hpp"
 #include "variational_formation/core/scenario.hpp"
 #include "variational_formation/core/variational_update.hpp"
 
@@ -77,7 +78,7 @@ class LockstepAgent {
   bool finished() const { return scenario_.steps > 0 && step_ >= scenario_.steps; }
   const std::vector<double>& position() const { return q_; }
   const std::vector<double>& previousPosition() const { return qPrev_; }
-  const std::vector<int>& neighbourIds() const { return neighbourIds_; }
+  const std::vector<int>& neighbourIds() const { return neighbourhood_.neighbourIds(); }
   const Scenario& scenario() const { return scenario_; }
 
   static std::string describe(Receipt receipt);
@@ -88,27 +89,26 @@ class LockstepAgent {
     std::vector<double> position;
     std::vector<double> previousPosition;
   };
-  /// The forced update or start (doc/maths.md §9) from neighbourhoodPositions_; d doubles.
-  void manoeuvreStep(double* next) const;
+  /// The forced update or start (doc/maths.md §9) from the held positions; d doubles.
+  void manoeuvreStep(double* next);
   /// Neighbour's q_k if held, else nullptr.
   const double* neighbourPositionAtStep(const NeighbourState& s) const;
 
   Scenario scenario_;
-  Formation formation_;
+  // The formation as this agent knows it: its start, neighbours, the checks of a neighbour's
+  // state, grad_i V (scaled under a command) and its centroid offset.
+  AgentNeighbourhood neighbourhood_;
   VariationalCoefficients coefficients_;
   StartMethod start_;
   int id_;
   int dimension_;
   long step_ = 0;
   bool advanced_ = false;  // advance() ran since the start or the last resume()
-  std::vector<double> qPrev_, q_, v0_, qBeforePrev_;
-  std::vector<int> neighbourIds_;
+  std::vector<double> qPrev_, q_, qBeforePrev_;
   std::vector<NeighbourState> neighbours_;  // indexed by agent id (only neighbours used)
-  Positions neighbourhoodPositions_;  // q_k of self and neighbours (other columns unused), d x n
   // Set once the agent has a command (the scenario's manoeuvre, or a received one); until then
   // advance() runs today's update unchanged.
   std::unique_ptr<ManoeuvreModel> manoeuvre_;
-  MotionParameters motionParameters_;
 };
 
 }  // namespace vf
