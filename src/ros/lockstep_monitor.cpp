@@ -102,7 +102,7 @@ void LockstepMonitor::updateProgress() {
   }
   RunProgress next = toMessage(referee_->progressNow());
   // A pending command goes out at the allowed step, before the progress that counts it.
-  const long issuedBefore = commandsIssued_;
+  const long issuedBefore = commandsIssued();
   next.commands = issueCommands(next.allowed_step);
   if (!changed && next.commands == issuedBefore) return;
   if (waiting && referee_->running()) startedAt_ = ros::WallTime::now();
@@ -236,7 +236,7 @@ void LockstepMonitor::begin() {
   reportedConvergence_ = r.congruentSince >= 0 ? r.congruentSince : -2;
   firstStepAt_ = startedAt_ = ros::WallTime::now();
   progress_ = toMessage(referee_->progressNow());
-  progress_.commands = commandsIssued_;
+  progress_.commands = commandsIssued();
   for (Participant& a : agents_) a.seen = true;
   ROS_INFO("monitor: resuming a run in progress at step %ld (rebuilt from the agents' histories)", r.step);
   lastCompletedAt_ = ros::WallTime::now();

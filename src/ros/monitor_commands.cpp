@@ -107,8 +107,7 @@ long MonitorNode::issueCommands(long allowedStep) {
              desk_->issued().size(), c.first, c.second.velocity.x(), c.second.velocity.y(), c.second.velocity.z(),
              c.second.angularRate.x(), c.second.angularRate.y(), c.second.angularRate.z(), c.second.scale);
   }
-  commandsIssued_ = static_cast<long>(desk_->issued().size());
-  return commandsIssued_;
+  return commandsIssued();
 }
 
 void MonitorNode::resumeCommands(bool resumed) {
@@ -125,7 +124,6 @@ void MonitorNode::resumeCommands(bool resumed) {
       return;
     }
   }
-  commandsIssued_ = static_cast<long>(desk_->issued().size());
   if (!desk_->issued().empty()) publishCommands();
 }
 

@@ -76,7 +76,7 @@ void MonitorNode::writeResult(const std::string& result, const std::string& reas
   const FormationOutcome formation = formationOutcome(convergedStep_, finalError_, scenario_.timeStep);
   f << "result: " << result << "\nscenario: " << scenario_.name << "\nsteps: " << scenario_.steps
     << "\ncompleted_step: " << completedStep() << "\nconverged_step: " << convergedStep_ << "\nformation: \""
-    << formation.line << "\"\nfinal_max_distance_error: " << finalError_ << "\ndropped: " << dropped_ << "\ncommands: " << commandsIssued_
+    << formation.line << "\"\nfinal_max_distance_error: " << finalError_ << "\ndropped: " << dropped_ << "\ncommands: " << commandsIssued()
     << "\ncommands_refused: " << commandsRefused_
     << "\nreason: \"" << quoted << "\"\n";
   if (!f) ROS_ERROR("monitor: cannot write the result file %s", resultFile_.c_str());

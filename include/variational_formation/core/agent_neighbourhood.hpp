@@ -39,12 +39,7 @@ class AgentNeighbourhood {
    */
   template <class NeighbourPosition>
   void gradient(const double* own, NeighbourPosition neighbourPosition, double* out) {
-    const int d = dimension();
-    for (int a = 0; a < d; ++a) view_(a, id_) = own[a];
-    for (int j : neighbourIds_) {
-      const double* qj = neighbourPosition(j);
-      for (int a = 0; a < d; ++a) view_(a, j) = qj[a];
-    }
+    view(own, neighbourPosition);
     formation_.agentGradient(id_, view_, out);
   }
 
@@ -56,12 +51,7 @@ class AgentNeighbourhood {
   template <class NeighbourPosition>
   void forcedGradient(const double* own, NeighbourPosition neighbourPosition, double scaleSquared, bool rotates,
                       double* gradient, double* offset) {
-    const int d = dimension();
-    for (int a = 0; a < d; ++a) view_(a, id_) = own[a];
-    for (int j : neighbourIds_) {
-      const double* qj = neighbourPosition(j);
-      for (int a = 0; a < d; ++a) view_(a, j) = qj[a];
-    }
+    view(own, neighbourPosition);
     formation_.agentScaledGradient(id_, view_, scaleSquared, gradient);
     if (rotates) centroidOffset(formation_, motion_, id_, view_, offset);
   }
@@ -70,6 +60,17 @@ class AgentNeighbourhood {
   const MotionParameters& motion() const { return motion_; }
 
  private:
+  /// The agent's and its neighbours' positions into view_.
+  template <class NeighbourPosition>
+  void view(const double* own, NeighbourPosition neighbourPosition) {
+    const int d = dimension();
+    for (int a = 0; a < d; ++a) view_(a, id_) = own[a];
+    for (int j : neighbourIds_) {
+      const double* qj = neighbourPosition(j);
+      for (int a = 0; a < d; ++a) view_(a, j) = qj[a];
+    }
+  }
+
   Formation formation_;
   int id_;
   std::vector<int> neighbourIds_;

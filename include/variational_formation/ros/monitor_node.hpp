@@ -91,6 +91,8 @@ class MonitorNode {
   /// Issues what is pending at `step`, keeps the list on the parameter server, publishes it;
   /// @return the number of issued commands, for the progress.
   long issueCommands(long step);
+  /// How many commands have been issued (the result file, the progress).
+  long commandsIssued() const { return static_cast<long>(desk_->issued().size()); }
   /// A new run forgets an earlier run's commands; a resumed one goes on from the kept list.
   void resumeCommands(bool resumed);
   /// The issued list on `command`, stamped as the mode stamps what it says (stampOf).
@@ -129,7 +131,7 @@ class MonitorNode {
   ros::WallTime firstStepAt_, lastCompletedAt_, lastReportAt_, startedAt_;
   long reportedConvergence_ = -2;  // the congruent stretch already announced (-2: none)
   long convergedStep_ = -1;        // first step of the congruent stretch at the newest step (-1: none)
-  long commandsIssued_ = 0, commandsRefused_ = 0;  // live commands, for the result file
+  long commandsRefused_ = 0;  // live commands refused, for the result file
   std::unique_ptr<protocol::CommandDesk> desk_;
   ros::NodeHandle pnh_;
   ros::Subscriber velocityCommandSub_, scaleCommandSub_;

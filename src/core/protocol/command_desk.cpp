@@ -32,12 +32,9 @@ Command CommandDesk::nextAt(long step) const {
   return c;
 }
 
-bool CommandDesk::offerVelocity(const Vector3& velocity, const Vector3& angularRate, std::string& why) {
-  Command c;
-  c.velocity = velocity;
-  c.angularRate = angularRate;
+bool CommandDesk::acceptable(const Command& c, const std::string& field, std::string& why) const {
   try {
-    validateCommand(c, scenario_.dimension, scenario_.timeStep, CommandFieldNames::keys("cmd_vel"));
+    validateCommand(c, scenario_.dimension, scenario_.timeStep, CommandFieldNames::keys(field));
   } catch (const InvalidInput& e) {
     why = e.what();
     return false;
@@ -46,40 +43,43 @@ bool CommandDesk::offerVelocity(const Vector3& velocity, const Vector3& angularR
     why = whyNoTurn_;
     return false;
   }
+  return true;
+}
+
+bool CommandDesk::offerVelocity(const Vector3& velocity, const Vector3& angularRate, std::string& why) {
+  Command c;
+  c.velocity = velocity;
+  c.angularRate = angularRate;
+  if (!acceptable(c, "cmd_vel", why)) return false;
   velocity_ = velocity;
   angularRate_ = angularRate;
-  pendingVelocity_ = pending_ = true;
+  pendingVelocity_ = true;
   return true;
 }
 
 bool CommandDesk::offerScale(double scale, std::string& why) {
   Command c;
   c.scale = scale;
-  try {
-    validateCommand(c, scenario_.dimension, scenario_.timeStep, CommandFieldNames::keys("scale"));
-  } catch (const InvalidInput& e) {
-    why = e.what();
-    return false;
-  }
+  if (!acceptable(c, "scale", why)) return false;
   scale_ = scale;
-  pendingScale_ = pending_ = true;
+  pendingScale_ = true;
   return true;
 }
 
 bool CommandDesk::issue(long allowedStep) {
-  if (!pending_ || allowedStep < 0) return false;
+  if (!pending() || allowedStep < 0) return false;
   if (!issued_.empty() && issued_.back().first >= allowedStep) return false;
   const Command c = nextAt(allowedStep);
   issued_.emplace_back(allowedStep, c);
   schedule_.replaceFrom(allowedStep, c);
-  pending_ = pendingVelocity_ = pendingScale_ = false;
+  pendingVelocity_ = pendingScale_ = false;
   return true;
 }
 
 void CommandDesk::resume(const std::vector<IssuedCommand>& issued) {
   issued_ = issued;
   schedule_ = appliedSchedule(scenario_, issued_);
-  pending_ = pendingVelocity_ = pendingScale_ = false;
+  pendingVelocity_ = pendingScale_ = false;
 }
 
 }  // namespace protocol

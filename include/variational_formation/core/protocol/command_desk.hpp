@@ -44,7 +44,7 @@ class CommandDesk {
   bool offerScale(double scale, std::string& why);
 
   /// A command waits to be issued.
-  bool pending() const { return pending_; }
+  bool pending() const { return pendingVelocity_ || pendingScale_; }
   /**
    * Issues the pending command at `allowedStep` (>= 0) if there is one and nothing was issued at
    * this step or later yet. @return whether it issued one.
@@ -66,11 +66,13 @@ class CommandDesk {
  private:
   /// The command of the next issue: what the schedule has at that step, with the offered halves.
   Command nextAt(long step) const;
+  /// validateCommand (fields named `field`.velocity, ...) and, if it turns, whether the formation
+  /// can; false with `why` otherwise.
+  bool acceptable(const Command& command, const std::string& field, std::string& why) const;
 
   Scenario scenario_;
   bool canTurn_ = true;
   std::string whyNoTurn_;
-  bool pending_ = false;
   bool pendingVelocity_ = false, pendingScale_ = false;
   Vector3 velocity_ = Vector3::Zero(), angularRate_ = Vector3::Zero();
   double scale_ = 1.0;
