@@ -81,12 +81,12 @@ double Formation::potential(const Positions& q) const {
   return v;
 }
 
-double Formation::agentPotential(int agent, const Positions& q) const {
+double Formation::agentPotential(int agent, const Positions& q, double scaleSquared) const {
   double v = 0.0;
   const double* qi = q.col(agent).data();
   for (const Neighbour& nb : neighbours_[agent]) {
     const double gamma =
-        squaredDistance(qi, q.col(nb.agent).data(), dimension_) - nb.desiredDistanceSquared;
+        squaredDistance(qi, q.col(nb.agent).data(), dimension_) - scaleSquared * nb.desiredDistanceSquared;
     v += 0.125 * gamma * gamma;
   }
   return v;
@@ -186,20 +186,20 @@ bool Formation::isMinimallyRigid(const Positions& q) const {
   return isInfinitesimallyRigid(q) && static_cast<int>(edges_.size()) == needed;
 }
 
-Eigen::VectorXd Formation::distanceErrors(const Positions& q) const {
+Eigen::VectorXd Formation::distanceErrors(const Positions& q, double scale) const {
   Eigen::VectorXd err(static_cast<Eigen::Index>(edges_.size()));
   for (std::size_t e = 0; e < edges_.size(); ++e) {
     const Edge& edge = edges_[e];
     err(static_cast<Eigen::Index>(e)) =
         std::sqrt(squaredDistance(q.col(edge.tail).data(), q.col(edge.head).data(), dimension_)) -
-        edge.desiredDistance;
+        scale * edge.desiredDistance;
   }
   return err;
 }
 
-double Formation::maxDistanceError(const Positions& q) const {
+double Formation::maxDistanceError(const Positions& q, double scale) const {
   if (edges_.empty()) return 0.0;
-  return distanceErrors(q).cwiseAbs().maxCoeff();
+  return distanceErrors(q, scale).cwiseAbs().maxCoeff();
 }
 
 bool Formation::allSlowerThan(const Velocities& v, double maxSpeed) const {
@@ -209,12 +209,12 @@ bool Formation::allSlowerThan(const Velocities& v, double maxSpeed) const {
   return true;
 }
 
-double Formation::congruenceSlack(const Positions& q, double tolerance) const {
+double Formation::congruenceSlack(const Positions& q, double tolerance, double scale) const {
   const int n = agentCount();
   double slack = std::numeric_limits<double>::infinity();
   for (int i = 0; i < n; ++i) {
     for (int j = i + 1; j < n; ++j) {
-      const double desired = (desiredShape_.col(i) - desiredShape_.col(j)).norm();
+      const double desired = scale * (desiredShape_.col(i) - desiredShape_.col(j)).norm();
       const double error = std::abs((q.col(i) - q.col(j)).norm() - desired);
       // Negative exactly when error > tolerance * desired (two distinct doubles never differ
       // by 0), NaN when either is NaN: the first such pair ends the test.
@@ -232,12 +232,16 @@ bool Formation::isCongruent(const Positions& q, const Velocities& v, double tole
   return allSlowerThan(v, maxSpeed) && congruenceSlack(q, tolerance) >= 0.0;
 }
 
-bool CongruenceTracker::check(const Formation& formation, const Positions& q, const Velocities& v) {
+bool CongruenceTracker::check(const Formation& formation, const Positions& q, const Velocities& v, double scale) {
   if (!formation.allSlowerThan(v, maxSpeed_)) return false;
-  if (anchored_) {
-    double first = 0.0, second = 0.0;  // the two largest displacements from the anchor
+  const Eigen::VectorXd centroid = q.rowwise().mean();
+  if (anchored_ && scale == anchorScale_) {
+    // A pair distance does not change when both ends move by the same vector: measure each
+    // agent's displacement after moving the anchor by the change of the centroid.
+    const Eigen::VectorXd shift = centroid - anchorCentroid_;
+    double first = 0.0, second = 0.0;  // the two largest displacements from the shifted anchor
     for (int i = 0; i < formation.agentCount(); ++i) {
-      const double d = (q.col(i) - anchor_.col(i)).norm();
+      const double d = (q.col(i) - anchor_.col(i) - shift).norm();
       if (d > first) {
         second = first;
         first = d;
@@ -249,13 +253,15 @@ bool CongruenceTracker::check(const Formation& formation, const Positions& q, co
   }
   ++fullTests_;
   anchored_ = false;
-  const double slack = formation.congruenceSlack(q, tolerance_);
+  const double slack = formation.congruenceSlack(q, tolerance_, scale);
   if (!(slack >= 0.0)) return false;
   // A slack at the level of rounding (relative to the coordinates) certifies nothing: keep
   // testing in full then.
   if (std::isfinite(slack) && slack > 1e-9 * q.cwiseAbs().maxCoeff()) {
     anchored_ = true;
     anchor_ = q;
+    anchorCentroid_ = centroid;
+    anchorScale_ = scale;
     slack_ = slack;
   }
   return true;

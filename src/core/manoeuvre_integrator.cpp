@@ -1,5 +1,7 @@
 #include "variational_formation/core/manoeuvre_integrator.hpp"
 
+#include "variational_formation/core/metrics.hpp"
+
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/validation.hpp"
 
@@ -80,12 +82,8 @@ Momenta ManoeuvreIntegrator::momenta() const {
 }
 
 double ManoeuvreIntegrator::energy() const {
-  if (step_ == 0) {
-    return 0.5 * v0_.squaredNorm() + formation_.scaledPotential(q_, model_.intervalGains(0).scaleSquared);
-  }
-  const double s2 = model_.intervalGains(step_ - 1).scaleSquared;
-  const double kinetic = 0.5 * ((q_ - qPrev_) / timeStep_).squaredNorm();
-  return kinetic + 0.5 * (formation_.scaledPotential(qPrev_, s2) + formation_.scaledPotential(q_, s2));
+  if (step_ == 0) return continuousEnergy(formation_, q_, v0_, model_.intervalGains(0).scaleSquared);
+  return discreteEnergy(formation_, timeStep_, qPrev_, q_, model_.intervalGains(step_ - 1).scaleSquared);
 }
 
 }  // namespace vf

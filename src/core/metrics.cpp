@@ -33,31 +33,32 @@ void discreteHamiltonianFlow(const Formation& formation, const VariationalCoeffi
 }
 
 double discreteEnergy(const Formation& formation, double timeStep, const Positions& qk,
-                      const Positions& qk1) {
+                      const Positions& qk1, double scaleSquared) {
   const double kinetic = 0.5 * ((qk1 - qk) / timeStep).squaredNorm();
-  return kinetic + 0.5 * (formation.potential(qk) + formation.potential(qk1));
+  return kinetic + 0.5 * (formation.scaledPotential(qk, scaleSquared) + formation.scaledPotential(qk1, scaleSquared));
 }
 
 Eigen::VectorXd agentDiscreteEnergy(const Formation& formation, double timeStep,
-                                    const Positions& qk, const Positions& qk1) {
+                                    const Positions& qk, const Positions& qk1, double scaleSquared) {
   Eigen::VectorXd e(formation.agentCount());
   for (int i = 0; i < formation.agentCount(); ++i) {
     const double kinetic = 0.5 * ((qk1.col(i) - qk.col(i)) / timeStep).squaredNorm();
     e(i) = kinetic +
-           0.5 * (formation.agentPotential(i, qk) + formation.agentPotential(i, qk1));
+           0.5 * (formation.agentPotential(i, qk, scaleSquared) + formation.agentPotential(i, qk1, scaleSquared));
   }
   return e;
 }
 
-double continuousEnergy(const Formation& formation, const Positions& q, const Velocities& v) {
-  return 0.5 * v.squaredNorm() + formation.potential(q);
+double continuousEnergy(const Formation& formation, const Positions& q, const Velocities& v,
+                        double scaleSquared) {
+  return 0.5 * v.squaredNorm() + formation.scaledPotential(q, scaleSquared);
 }
 
 Eigen::VectorXd agentContinuousEnergy(const Formation& formation, const Positions& q,
-                                      const Velocities& v) {
+                                      const Velocities& v, double scaleSquared) {
   Eigen::VectorXd e(formation.agentCount());
   for (int i = 0; i < formation.agentCount(); ++i) {
-    e(i) = 0.5 * v.col(i).squaredNorm() + formation.agentPotential(i, q);
+    e(i) = 0.5 * v.col(i).squaredNorm() + formation.agentPotential(i, q, scaleSquared);
   }
   return e;
 }

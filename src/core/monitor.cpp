@@ -11,6 +11,7 @@ FormationMonitor::FormationMonitor(const Scenario& scenario, double tolerance, d
     : scenario_(scenario),
       formation_(makeFormation(scenario)),
       coefficients_(scenario.timeStep, scenario.dampingGain),
+      schedule_(scheduleFromSegments(scenario.manoeuvre, scenario.timeStep)),
       tolerance_(tolerance),
       maxSpeed_(maxSpeed),
       congruence_(tolerance, maxSpeed) {
@@ -86,31 +87,56 @@ std::vector<FormationSnapshot> FormationMonitor::takeCompleted() {
   return done;
 }
 
+namespace {
+
+/// v_i - (v* + omega* x (q_i - c)), c the centroid of q: the velocities in the frame the command
+/// moves (v itself when the command does not move the formation).
+Velocities relativeToCommand(const Command& command, const Positions& q, const Velocities& v) {
+  if (command.velocity.isZero(0.0) && !command.rotates()) return v;
+  const int d = static_cast<int>(q.rows());
+  Vector3 centroid = Vector3::Zero();
+  centroid.head(d) = q.rowwise().mean();
+  Velocities relative = v;
+  for (Eigen::Index i = 0; i < q.cols(); ++i) {
+    Vector3 r = Vector3::Zero();
+    r.head(d) = q.col(i);
+    const Vector3 u = command.velocity + command.angularRate.cross(r - centroid);
+    relative.col(i) -= u.head(d);
+  }
+  return relative;
+}
+
+}  // namespace
+
 FormationSnapshot FormationMonitor::measureStep(long step, const Positions& qPrev, const Positions& q) {
   FormationSnapshot s;
   const double h = coefficients_.timeStep;
+  // The command of the interval that ends at t_k, as ManoeuvreModel::scaleAt and simulate take it.
+  const Command& command = schedule_.at(step > 0 ? step - 1 : 0);
+  const double scale = command.scale, scaleSquared = scale * scale;
   Positions p, v;
   if (step == 0) {
     v = scenario_.initialVelocities;
     p = v;
-    s.metrics.energy = continuousEnergy(formation_, q, v);
-    s.agentEnergy = agentContinuousEnergy(formation_, q, v);
+    s.metrics.energy = continuousEnergy(formation_, q, v, scaleSquared);
+    s.agentEnergy = agentContinuousEnergy(formation_, q, v, scaleSquared);
   } else {
     v = (q - qPrev) / h;
     p = discreteMomentumPlus(formation_, coefficients_, qPrev, q);
-    s.metrics.energy = discreteEnergy(formation_, h, qPrev, q);
-    s.agentEnergy = agentDiscreteEnergy(formation_, h, qPrev, q);
+    s.metrics.energy = discreteEnergy(formation_, h, qPrev, q, scaleSquared);
+    s.agentEnergy = agentDiscreteEnergy(formation_, h, qPrev, q, scaleSquared);
   }
   s.metrics.step = step;
   s.metrics.time = static_cast<double>(step) * h;
-  s.metrics.maxDistanceError = formation_.maxDistanceError(q);
+  s.metrics.maxDistanceError = formation_.maxDistanceError(q, scale);
   s.metrics.linearMomentum = linearMomentum(p);
   s.metrics.angularMomentum = angularMomentum(q, p);
   s.linearMomentumPredicted = noetherPrediction(p0_, coefficients_, step);
   s.angularMomentumPredicted = noetherPrediction(a0_, coefficients_, step);
-  s.edgeDistanceErrors = formation_.distanceErrors(q);
+  s.edgeDistanceErrors = formation_.distanceErrors(q, scale);
+  s.scale = scale;
   s.positions = q;
-  s.converged = congruence_.check(formation_, q, v);
+  s.converged = congruence_.check(formation_, q, relativeToCommand(command, q, v), scale);
   if (!s.converged) {
     congruentSince_ = -1;
   } else if (congruentSince_ < 0) {

@@ -16,7 +16,7 @@ StepMetrics measure(const Integrator& integrator) {
   m.time = integrator.time();
   m.energy = integrator.energy();
   const double scale = integrator.commandedScale();
-  m.maxDistanceError = maxScaledDistanceError(integrator.formation(), integrator.positions(), scale);
+  m.maxDistanceError = integrator.formation().maxDistanceError(integrator.positions(), scale);
   const Momenta p = integrator.momenta();
   m.linearMomentum = linearMomentum(p);
   m.angularMomentum = angularMomentum(integrator.positions(), p);

@@ -57,14 +57,7 @@ double meanScaleError(const Formation& formation, const Positions& q, double sca
   return counted == 0 ? 0.0 : sum / static_cast<double>(counted) - scale;
 }
 
-double maxScaledDistanceError(const Formation& formation, const Positions& q, double scale) {
-  if (scale == 1.0) return formation.maxDistanceError(q);
-  double worst = 0.0;
-  for (const Edge& e : formation.edges()) {
-    worst = std::max(worst, std::abs((q.col(e.tail) - q.col(e.head)).norm() - scale * e.desiredDistance));
-  }
-  return worst;
-}
+
 
 CommandedFrame commandedFrame(const CommandSchedule& schedule, long step, double timeStep) {
   CommandedFrame frame;

@@ -162,9 +162,9 @@ void addEdgesAndGhostEdges(const FormationSnapshot& s, const Formation& formatio
   ghost.color = rgba(0.7, 0.7, 0.7, 0.35);
   for (std::size_t e = 0; e < formation.edges().size(); ++e) {
     const Edge& edge = formation.edges()[e];
-    // Against s d_ij under a commanded scale s (the status measures against d_ij).
-    const double wanted = ghostAt.frame.scale * edge.desiredDistance;
-    const double error = (column3(s.positions, edge.tail) - column3(s.positions, edge.head)).norm() - wanted;
+    // The status's error, against s d_ij under a commanded scale s.
+    const double wanted = s.scale * edge.desiredDistance;
+    const double error = s.edgeDistanceErrors(static_cast<Eigen::Index>(e));
     const double badness = std::min(1.0, std::abs(error) / (0.1 * std::max(wanted, 1e-9)));
     const std_msgs::ColorRGBA c = rgba(badness, 1.0 - 0.8 * badness, 0.1, 1.0);
     for (int end : {edge.tail, edge.head}) {

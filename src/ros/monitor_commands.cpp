@@ -101,6 +101,7 @@ long MonitorNode::issueCommands(long allowedStep) {
     for (const protocol::IssuedCommand& c : desk_->issued()) issued.add(c.first, c.second);
     writeCommands(kept, issued);
     pnh_.setParam("commands", kept.str());
+    measureUnder(desk_->schedule());
     publishCommands();
     const protocol::IssuedCommand& c = desk_->issued().back();
     ROS_INFO("monitor: command %zu from step %ld: v* (%g, %g, %g) m/s, w* (%g, %g, %g) rad/s, s %g",
@@ -118,6 +119,7 @@ void MonitorNode::resumeCommands(bool resumed) {
     try {
       const CommandSchedule issued = parseCommands(kept, pnh_.resolveName("commands"), scenario_);
       desk_->resume(issued.entries());
+      measureUnder(desk_->schedule());
       ROS_INFO("monitor: going on with the %zu commands issued before the restart", issued.entries().size());
     } catch (const InvalidInput& e) {
       finish(RunProgress::FAILED, std::string("the kept commands cannot be read: ") + e.what());

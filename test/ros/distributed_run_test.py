@@ -3,7 +3,7 @@
 
 Private parameters:
   scenario          name in config/ (required)
-  expect            converged | planar | free_particle
+  expect            converged | planar | free_particle | manoeuvre
   real_time_factor  > 0: the run is paced, and status k arrives about k h / r after status 0
   output_dir        where formation.launch writes the bag and the result file (removed after)
   injected          a foreign node forged states of agent_0: they must all have been dropped
@@ -103,9 +103,18 @@ class DistributedRun(unittest.TestCase, vf_rostest.RunChecks):
             k = int(self.scenario["steps"])
             q = {i: self.recording.states[(i, k)][0].position for i in range(n)}
             desired = {a["id"]: a["desired_position"] for a in self.scenario["agents"]}
+            worst = 0.0
             for a, b in self.scenario["edges"]:
                 ratio = math.dist(q[a], q[b]) / (s * math.dist(desired[a], desired[b]))
                 self.assertLess(abs(ratio - 1.0), 1e-3, f"edge {a}-{b}")
+                worst = max(worst, abs(math.dist(q[a], q[b]) - s * math.dist(desired[a], desired[b])))
+            # The monitor measures against s d_ij and relative to the commanded motion: the
+            # formation travelling at v* with the grown shape is congruent, and says so.
+            self.assertAlmostEqual(last.max_distance_error, worst, delta=1e-12)
+            self.assertTrue(last.converged, f"max distance error {last.max_distance_error}")
+            self.assertGreater(last.converged_step, 0)
+            self.assertEqual(self.result["converged_step"], last.converged_step)
+            self.assertTrue(str(self.result["formation"]).startswith("converged"), self.result)
         else:
             self.fail(f"unknown ~expect {self.expect}")
         self.assertEqual(n, len({i for i, _ in self.recording.states}))

@@ -46,8 +46,9 @@ class Formation {
 
   /// V(q), doc/maths.md §1.
   double potential(const Positions& q) const;
-  /// 1/2 sum_{j in N_i} V_ij(q): each edge's potential split half to each endpoint.
-  double agentPotential(int agent, const Positions& q) const;
+  /// 1/2 sum_{j in N_i} V_ij(q): each edge's potential split half to each endpoint (of V_s with
+  /// s^2 = scaleSquared under a commanded scale).
+  double agentPotential(int agent, const Positions& q, double scaleSquared = 1.0) const;
 
   /**
    * grad_i V = sum_{j in N_i} (|q_i - q_j|^2 - d_ij^2)(q_i - q_j) (doc/maths.md §1; the paper's
@@ -77,10 +78,10 @@ class Formation {
   /// Infinitesimally rigid and |E| = dn - d(d+1)/2.
   bool isMinimallyRigid(const Positions& q) const;
 
-  /// Per edge |q_i - q_j| - d_ij, in the order of edges().
-  Eigen::VectorXd distanceErrors(const Positions& q) const;
-  /// max_e |distance error_e|, 0 without edges.
-  double maxDistanceError(const Positions& q) const;
+  /// Per edge |q_i - q_j| - s d_ij, in the order of edges(); s is a commanded scale (doc/maths.md §9).
+  Eigen::VectorXd distanceErrors(const Positions& q, double scale = 1.0) const;
+  /// max_e |distance error_e| against s d_ij, 0 without edges.
+  double maxDistanceError(const Positions& q, double scale = 1.0) const;
 
   /**
    * Congruence (paper Section 6.2): every pairwise distance, over all pairs, is within
@@ -90,10 +91,10 @@ class Formation {
                    double maxSpeed = 0.1) const;
   /// Every agent's speed is below maxSpeed (isCongruent's speed part).
   bool allSlowerThan(const Velocities& v, double maxSpeed) const;
-  /// isCongruent's pair part: min over all pairs of tolerance d_ij - |a_ij - d_ij| (>= 0 iff every
-  /// pair is within tolerance; +inf with fewer than two agents). It stops at the first pair
-  /// outside, and returns that pair's negative (or NaN) value.
-  double congruenceSlack(const Positions& q, double tolerance) const;
+  /// isCongruent's pair part: min over all pairs of tolerance D_ij - |a_ij - D_ij| with D_ij = s d_ij,
+  /// s a commanded scale (>= 0 iff every pair is within tolerance; +inf with fewer than two agents).
+  /// It stops at the first pair outside, and returns that pair's negative (or NaN) value.
+  double congruenceSlack(const Positions& q, double tolerance, double scale = 1.0) const;
 
  private:
   int dimension_;
@@ -114,8 +115,13 @@ class Formation {
 class CongruenceTracker {
  public:
   CongruenceTracker(double tolerance, double maxSpeed) : tolerance_(tolerance), maxSpeed_(maxSpeed) {}
-  /// formation.isCongruent(q, v, tolerance, maxSpeed), for one formation throughout.
-  bool check(const Formation& formation, const Positions& q, const Velocities& v);
+  /**
+   * formation.isCongruent(q, v, tolerance, maxSpeed) for one formation throughout, with the pairs
+   * measured against s d_ij (s = `scale`). Under a commanded motion `v` is the velocity relative
+   * to it (FormationMonitor). Displacements from the anchor are taken after moving the anchor's
+   * centroid onto q's, so a translating formation stays anchored; a new scale tests in full.
+   */
+  bool check(const Formation& formation, const Positions& q, const Velocities& v, double scale = 1.0);
   /// How many full O(n^2) pair tests check() ran.
   long fullTests() const { return fullTests_; }
 
@@ -123,6 +129,8 @@ class CongruenceTracker {
   double tolerance_, maxSpeed_;
   bool anchored_ = false;
   Positions anchor_;
+  Eigen::VectorXd anchorCentroid_;
+  double anchorScale_ = 1.0;
   double slack_ = 0.0;
   long fullTests_ = 0;
 };

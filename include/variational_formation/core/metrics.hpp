@@ -23,17 +23,19 @@ void discreteHamiltonianFlow(const Formation& formation, const VariationalCoeffi
                              const Positions& qk, const Momenta& pk, Positions& qk1,
                              Momenta& pk1);
 
-/// E_d(q_k, q_{k+1}) = 1/2 |v_k|^2 + 1/2 (V(q_k) + V(q_{k+1})).
+/// E_d(q_k, q_{k+1}) = 1/2 |v_k|^2 + 1/2 (V(q_k) + V(q_{k+1})); under a commanded scale s, V_s
+/// with s^2 = scaleSquared (doc/maths.md §9).
 double discreteEnergy(const Formation& formation, double timeStep, const Positions& qk,
-                      const Positions& qk1);
+                      const Positions& qk1, double scaleSquared = 1.0);
 /// Per agent: 1/2 |v_{i,k}|^2 + 1/2 (V_i(q_k) + V_i(q_{k+1})), V_i = agentPotential. Sums to E_d.
 Eigen::VectorXd agentDiscreteEnergy(const Formation& formation, double timeStep,
-                                    const Positions& qk, const Positions& qk1);
-/// E = 1/2 |v|^2 + V(q).
-double continuousEnergy(const Formation& formation, const Positions& q, const Velocities& v);
+                                    const Positions& qk, const Positions& qk1, double scaleSquared = 1.0);
+/// E = 1/2 |v|^2 + V(q) (V_s under a commanded scale).
+double continuousEnergy(const Formation& formation, const Positions& q, const Velocities& v,
+                        double scaleSquared = 1.0);
 /// Per agent 1/2 |v_i|^2 + V_i(q).
 Eigen::VectorXd agentContinuousEnergy(const Formation& formation, const Positions& q,
-                                      const Velocities& v);
+                                      const Velocities& v, double scaleSquared = 1.0);
 
 /// P = sum_i p_i (z = 0 in 2D).
 Vector3 linearMomentum(const Momenta& p);

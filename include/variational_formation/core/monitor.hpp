@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "variational_formation/core/manoeuvre_command.hpp"
 #include "variational_formation/core/scenario.hpp"
 #include "variational_formation/core/simulation.hpp"
 #include "variational_formation/core/variational_update.hpp"
@@ -16,9 +17,10 @@ struct FormationSnapshot {
   Vector3 linearMomentumPredicted;     ///< e^{-kappa t_k} P_0
   Vector3 angularMomentumPredicted;    ///< e^{-kappa t_k} A_0
   Eigen::VectorXd agentEnergy;
-  Eigen::VectorXd edgeDistanceErrors;
+  Eigen::VectorXd edgeDistanceErrors;   ///< |q_i - q_j| - s d_ij per edge
+  double scale = 1.0;                  ///< s, the commanded scale the step is measured against
   Positions positions;                 ///< q_k, d x n
-  bool converged = false;              ///< congruent at this step
+  bool converged = false;              ///< congruent (with s d_ij, moving as commanded) at this step
   long convergedStep = -1;             ///< first step of the current congruent stretch
 };
 
@@ -26,7 +28,8 @@ struct FormationSnapshot {
  * The monitor's core: collects agents' states (q_k, q_{k-1}) by step and, for each step that
  * every agent has reported, computes the metrics exactly as VariationalIntegrator::momenta()
  * and energy() define them (p+_k and E_d(q_{k-1}, q_k); v_0 and the continuous energy at
- * k = 0), so they match `simulate --metrics`.
+ * k = 0), so they match `simulate --metrics`; under commands the distances, energy and congruence
+ * are the commanded ones (setSchedule).
  */
 class FormationMonitor {
  public:
@@ -52,6 +55,15 @@ class FormationMonitor {
   /// Completed steps in order, each removed from the buffer once returned.
   std::vector<FormationSnapshot> takeCompleted();
 
+  /**
+   * The commanded motion the agents apply (protocol::appliedSchedule; at first the scenario's
+   * `manoeuvre:`). Step k is measured under the command of interval k - 1 (interval 0 at k = 0):
+   * distances against s d_ij, energy with V_s, and congruence with the velocities relative to the
+   * commanded motion v* + omega* x (q_i - c), c the centroid. Steps already measured keep theirs.
+   */
+  void setSchedule(const CommandSchedule& schedule) { schedule_ = schedule; }
+  const CommandSchedule& schedule() const { return schedule_; }
+
   long nextStep() const { return next_; }
   const Formation& formation() const { return formation_; }
   const Scenario& scenario() const { return scenario_; }
@@ -67,6 +79,7 @@ class FormationMonitor {
   Scenario scenario_;
   Formation formation_;
   VariationalCoefficients coefficients_;
+  CommandSchedule schedule_;
   double tolerance_, maxSpeed_;
   CongruenceTracker congruence_;  // isCongruent at amortised O(n) per step
   std::map<long, Pending> pending_;

@@ -70,6 +70,9 @@ class MonitorNode {
   virtual std::string waitingFor() const = 0;
   virtual long completedStep() const = 0;
   virtual const FormationMonitor& measure() const = 0;
+  /// Hands the applied schedule to the mode's referee: the steps it measures from now on are
+  /// measured under it (FormationMonitor::setSchedule).
+  virtual void measureUnder(const CommandSchedule& schedule) = 0;
   /// The stamp of what the monitor says about `step`: its simulated time in lockstep (replay and
   /// /clock need it), ROS time now in timed mode (robots and tf consumers live in it).
   virtual ros::Time stampOf(long step) const = 0;
@@ -178,6 +181,7 @@ class LockstepMonitor : public MonitorNode {
   std::string waitingFor() const override { return referee_->waitingFor(recorder_.node); }
   long completedStep() const override { return referee_->completedStep(); }
   const FormationMonitor& measure() const override { return referee_->monitor(); }
+  void measureUnder(const CommandSchedule& schedule) override { referee_->setSchedule(schedule); }
   ros::Time stampOf(long step) const override { return ros::Time(std::max(0L, step) * scenario_.timeStep); }
   void commandOffered() override { updateProgress(); }  // issued at the allowed step, then counted
   void onRecorderProgress(const ros::MessageEvent<RunProgress const>& event);
@@ -214,6 +218,7 @@ class TimedMonitor : public MonitorNode {
   std::string waitingFor() const override;
   long completedStep() const override { return referee_->completedStep(); }
   const FormationMonitor& measure() const override { return referee_->monitor(); }
+  void measureUnder(const CommandSchedule& schedule) override { referee_->setSchedule(schedule); }
   ros::Time stampOf(long) const override { return ros::Time::now(); }
   /// Timed agents apply the newest command at their next tick: issued at once.
   void commandOffered() override;

@@ -207,6 +207,8 @@ class LockstepReferee {
   long window() const { return window_; }
   bool recording() const { return recording_; }
   const FormationMonitor& monitor() const { return *monitor_; }
+  /// The commands the agents apply, for the steps measured from now on (FormationMonitor::setSchedule).
+  void setSchedule(const CommandSchedule& schedule) { monitor_->setSchedule(schedule); }
 
  private:
   void end(Progress::State state, const std::string& reason) {

@@ -92,6 +92,8 @@ class TimedReferee {
   /// Age [s] of the oldest state the latest tick used.
   double dataAge() const { return dataAge_; }
   const FormationMonitor& monitor() const { return *monitor_; }
+  /// The commands the agents apply, for the steps measured from now on (FormationMonitor::setSchedule).
+  void setSchedule(const CommandSchedule& schedule) { monitor_->setSchedule(schedule); }
 
  private:
   std::unique_ptr<FormationMonitor> monitor_;
