@@ -11,7 +11,7 @@ target_sources(variational_formation_ros PRIVATE src/ros/timed_agent_node.cpp sr
 target_sources(variational_formation_ros PRIVATE src/ros/lockstep_monitor.cpp src/ros/monitor_commands.cpp
   src/ros/timed_monitor.cpp src/ros/monitor_outputs.cpp
   src/ros/recorder_bag.cpp src/ros/recorder_commands.cpp
-  src/ros/service_call.cpp src/ros/state_batch.cpp)
+  src/ros/service_call.cpp src/ros/state_batch.cpp src/ros/periodic_call.cpp)
 add_dependencies(variational_formation_ros ${PROJECT_NAME}_gencfg)
 # catkin's include path is given to each ROS target privately (never exported: catkin_lint).
 target_include_directories(variational_formation_ros SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
@@ -111,6 +111,10 @@ if(CATKIN_ENABLE_TESTING)
   # rosunit-*.xml, which scripts/test.sh pairs with the rostest-*.xml wrappers.
   catkin_run_tests_target("unittest" multihost "unittest-multihost.xml"
     COMMAND "/usr/bin/python3 ${PROJECT_SOURCE_DIR}/test/ros/multihost_test.py --gtest_output=xml:${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/unittest-multihost.xml")
+  # A 60-agent formation in three nodelet managers, a third on each of three namespace hosts, the
+  # monitor and recorder on a fourth; one manager SIGKILLed mid-run (as root, like multihost).
+  catkin_run_tests_target("unittest" sharded "unittest-sharded.xml"
+    COMMAND "/usr/bin/python3 ${PROJECT_SOURCE_DIR}/test/ros/sharded_test.py --gtest_output=xml:${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/unittest-sharded.xml")
 endif()
 
 # robot_sim: one simulated holonomic robot (core PointRobot) per agent, with the interfaces of a

@@ -12,11 +12,17 @@
 #     the launch, from /proc every VF_BENCH_SAMPLE s) over the monitor's stepping window,
 #     divided by the window and the agent count (100 = one core);
 #   RSS MiB/agent: the largest total resident memory of those processes, divided by the agent
-#     count.
+#     count;
+#   start s: from roslaunch's start to the monitor's step 0 (every agent loaded, recovered and
+#     heard);
+#   exact: with VF_BENCH_RECORD=1 the run is recorded (record:=true, so the figures are the
+#     recorded throughput) and benchmark/bag_vs_simulate.py compares every state of the bag with
+#     simulate, bit for bit: yes or no; "-" without recording.
 # usage: ./scripts/benchmark_ros.sh [agent counts...]          (default 6 20 50 100 200)
 # environment: VF_BENCH_MODES (default "process nodelet"), VF_BENCH_STEPS (steps per run;
 #   default max(600, 120000 / agents), about 10-40 s per run), VF_BENCH_TIMEOUT (s per run,
-#   default 900), VF_BENCH_SAMPLE (s between samples, default 0.5).
+#   default 900), VF_BENCH_SAMPLE (s between samples, default 0.5), VF_BENCH_RECORD (1: record and
+#   check exactness; default 0).
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 vf_install_dependencies
 vf_build
@@ -28,6 +34,7 @@ counts=("$@")
 read -r -a modes <<<"${VF_BENCH_MODES:-process nodelet}"
 timeout_s="${VF_BENCH_TIMEOUT:-900}"
 sample_s="${VF_BENCH_SAMPLE:-0.5}"
+record="${VF_BENCH_RECORD:-0}"
 monitor_line='monitor: [0-9]+ steps in'
 
 # Every VF_BENCH_SAMPLE s until the launch ends or the monitor's final line is in the log:
@@ -90,7 +97,8 @@ for m in "${modes[@]}"; do
   mode_supported "$m" || { skip[$m]=1; echo "benchmark_ros: formation.launch has no '$m' argument: $m is n/a" >&2; }
 done
 
-printf '%7s %-8s %7s %9s %17s %11s %14s\n' agents mode steps "steps/s" "real-time factor" "CPU%/agent" "RSS MiB/agent"
+row() { printf '%7s %-8s %7s %9s %17s %11s %14s %8s %6s\n' "$@"; }
+row agents mode steps "steps/s" "real-time factor" "CPU%/agent" "RSS MiB/agent" "start s" exact
 for n in "${counts[@]}"; do
   steps="${VF_BENCH_STEPS:-$(( 120000 / n > 600 ? 120000 / n : 600 ))}"
   scenario="$tmp/ring$n.yaml"
@@ -98,7 +106,7 @@ for n in "${counts[@]}"; do
     --steps "$steps" --name "ring$n" --out "$scenario"
   for m in "${modes[@]}"; do
     if [ -n "${skip[$m]:-}" ]; then
-      printf '%7s %-8s %7s %9s %17s %11s %14s\n' "$n" "$m" "$steps" n/a n/a n/a n/a
+      row "$n" "$m" "$steps" n/a n/a n/a n/a n/a n/a
       continue
     fi
     port="$(vf_free_port 11500 100)"
@@ -106,6 +114,8 @@ for n in "${counts[@]}"; do
     : >"$samples"
     extra=()
     [ "$m" = nodelet ] && extra=(nodelet:=true)
+    [ "$record" = 1 ] && extra+=(record:=true output_dir:="$tmp/out_${m}_$n")
+    launched=$EPOCHREALTIME
     ROS_MASTER_URI="http://localhost:$port" ROS_LOG_DIR="$tmp/ros_log" \
       timeout -s INT -k 30 "$timeout_s" \
       roslaunch -p "$port" variational_formation formation.launch scenario:="$scenario" "${extra[@]}" \
@@ -119,15 +129,23 @@ for n in "${counts[@]}"; do
     rate=$(echo "$line" | sed -nE 's/.*: ([0-9]+) steps\/s.*/\1/p')
     rtf=$(echo "$line" | sed -nE 's/.*real-time factor ([0-9.]+).*/\1/p')
     seconds=$(echo "$line" | sed -nE 's/.* steps in ([0-9.]+) s.*/\1/p')
-    ended=$(echo "$line" | sed -nE 's/.*\[([0-9]+\.[0-9]+)\]: monitor: .*/\1/p')
+    ended=$(echo "$line" | sed -nE 's/.*\[([0-9]+\.[0-9]+)(, [0-9.]+)?\]: monitor: .*/\1/p')
     if [ -z "$rate" ]; then
       reason=$(sed -E 's/\x1b\[[0-9;]*m//g' "$log" | grep -iE 'error|fatal|exited|timeout' | tail -n 1 || true)
       echo "benchmark_ros: $m, $n agents: no monitor line, so $m is n/a from here (${reason:-see the launch output})" >&2
       skip[$m]=1
-      printf '%7s %-8s %7s %9s %17s %11s %14s\n' "$n" "$m" "$steps" n/a n/a n/a n/a
+      row "$n" "$m" "$steps" n/a n/a n/a n/a n/a n/a
       continue
     fi
     read -r cpu rss < <(summarise_samples "$samples" "$seconds" "$n" "$ended")
-    printf '%7s %-8s %7s %9s %17s %11s %14s\n' "$n" "$m" "$steps" "$rate" "$rtf" "$cpu" "$rss"
+    start=-
+    [ -n "$ended" ] && start=$(awk -v e="$ended" -v s="$seconds" -v l="$launched" 'BEGIN { printf "%.1f", e - s - l }')
+    exact=-
+    if [ "$record" = 1 ]; then
+      exact=no
+      python3 "$(dirname "${BASH_SOURCE[0]}")/../benchmark/bag_vs_simulate.py" "$scenario" "$tmp/out_${m}_$n/ring$n.bag" >&2 && exact=yes
+      rm -rf "$tmp/out_${m}_$n"
+    fi
+    row "$n" "$m" "$steps" "$rate" "$rtf" "$cpu" "$rss" "$start" "$exact"
   done
 done

@@ -13,17 +13,22 @@ usage: make_agents_launch.py --scenario FILE --out FILE [--rate R] [--order forw
                               [--seed N] [--respawn-delay S] [--robot true|false [--lag S] [--noise M]
                                [--kinematics holonomic|unicycle] [--feedback integrated|odometry]
                                [--hand-offset M] [--heading-seed N] [--heading-noise RAD]]]
-                             [--in-launch]
+                             [--ids LIST] [--manager-name NAME] [--agent-manager NAMES] [--in-launch]
 With --robot true (timed mode), each agent also gets a simulated robot, robot_sim, in
 formation/robot_<id> (odom and cmd_vel there), started at the scenario's initial position (a
 unicycle's hand point there, at the scenario's initial_heading or one drawn from --heading-seed).
 With --nodelet true (lockstep mode), every agent is a nodelet of one manager, formation/manager
 (the agent_manager node, which loads them itself; doc/distributed.md, "Nodelets"), instead of a
 node of its own.
+A formation spread over several machines (doc/distributed.md, "Sharded managers"): --ids 0-19
+writes only those agents (ranges and ids separated by commas), --manager-name manager_b names
+their manager formation/manager_b, and --agent-manager "manager_b manager_c manager_d" lists
+every manager of the formation, whose caller ids the agents' neighbours' states may carry.
 """
 import argparse
 import math
 import os
+import re
 import subprocess
 import sys
 from xml.sax.saxutils import quoteattr
@@ -88,11 +93,13 @@ def manager(args, ids):
     """The agents' nodelet manager, which loads every agent in `ids` (in that order) itself.
     Threads 0 means one (doc/distributed.md, "Threads")."""
     threads = args.nodelet_threads if int(args.nodelet_threads) > 0 else "1"
-    lines = ['  <node name="manager" ns="formation" pkg="variational_formation" type="agent_manager" clear_params="true"',
-             f'        respawn={quoteattr(args.respawn)} output="screen">']
+    lines = [f'  <node name={quoteattr(args.manager_name)} ns="formation" pkg="variational_formation" type="agent_manager"'
+             ' clear_params="true"', f'        respawn={quoteattr(args.respawn)} output="screen">']
+    # Managers on other machines: their agents' states, neighbours of these, carry their names.
+    others = (("agent_manager", "str", args.agent_manager),) if args.agent_manager else ()
     for name, kind, value in (("agents", "str", " ".join(str(i) for i in ids)), ("scenario", "str", args.scenario),
                               ("real_time_factor", "double", args.rate), ("stagger", "double", args.stagger),
-                              ("num_worker_threads", "int", threads)):
+                              ("num_worker_threads", "int", threads)) + others:
         lines.append(f"    <param name={quoteattr(name)} type={quoteattr(kind)} value={quoteattr(value)}/>")
     lines.append("  </node>")
     return lines
@@ -120,6 +127,28 @@ def seed(text):
     if not text.isdigit():
         fail(f"seed: must be an integer >= 0, got '{text}'")
     return int(text)
+
+
+def id_list(text):
+    """--ids: ids and ranges separated by commas ("0-19", "0-9,20,30-39"), in that order, each once."""
+    ids = []
+    for part in text.split(","):
+        low, dash, high = part.strip().partition("-")
+        if not low.isdigit() or (dash and not high.isdigit()):
+            fail(f"ids: expected ids or ranges separated by commas (0-19,40), got '{text}'")
+        span = range(int(low), int(high if dash else low) + 1)
+        if not span:
+            fail(f"ids: empty range '{part.strip()}'")
+        ids += [i for i in span if i not in ids]
+    return ids
+
+
+def node_name(flag):
+    def parse(text):
+        if not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", text):
+            fail(f"{flag}: expected a node name (a letter, then letters, digits or _), got '{text}'")
+        return text
+    return parse
 
 
 def agent_count(scenario, rate):
@@ -191,6 +220,13 @@ def main():
     parser.add_argument("--heading-noise", type=non_negative("heading_noise"), default="0.01")
     parser.add_argument("--nodelet", type=boolean("nodelet"), default="false")
     parser.add_argument("--nodelet-threads", type=non_negative_int("nodelet_threads"), default="0")
+    parser.add_argument("--ids", type=id_list, default=None,
+                        help="only these agents, ids and ranges separated by commas (0-19,40); default: all")
+    parser.add_argument("--manager-name", type=node_name("manager_name"), default="manager",
+                        help="with --nodelet true: the manager's name in formation/ (default manager), e.g. one per machine")
+    parser.add_argument("--agent-manager", default="",
+                        help="with --nodelet true: the formation's managers (names separated by spaces) whose caller id "
+                             "a neighbour's state may carry: every manager of a formation spread over machines")
     parser.add_argument("--in-launch", action="store_true")
     parser.error = lambda message: fail(message.replace("argument --", ""))
     args = parser.parse_args()
@@ -200,12 +236,21 @@ def main():
         fail("nodelet: only lockstep agents are nodelets; run timed agents as nodes (nodelet:=false)")
     if args.mode == "timed" and float(args.rate) <= 0:
         fail(f"rate: must be > 0 in timed mode (the tick period is h / rate), got {args.rate}")
+    if args.nodelet != "true" and (args.manager_name != "manager" or args.agent_manager):
+        fail("manager_name, agent_manager: only with nodelet true")
     count = agent_count(args.scenario, args.rate)
     ids = list(range(count))
+    if args.ids is not None:
+        beyond = [i for i in args.ids if i >= count]
+        if beyond:
+            fail(f"ids: agent {beyond[0]} does not exist (the scenario has {count} agents)")
+        ids = args.ids
     if args.order == "reverse":
         ids.reverse()
     lines = ["<launch>",
              f"  <!-- written by make_agents_launch.py for {args.scenario}: {count} agents -->"]
+    if args.ids is not None:
+        lines.append(f"  <!-- of them {len(ids)}: {' '.join(str(i) for i in ids)} -->")
     if args.nodelet == "true":
         lines += manager(args, ids)
         ids = []

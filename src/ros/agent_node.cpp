@@ -245,9 +245,9 @@ void AgentNode::start(const Recovery& recovery) {
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
   publish();  // the first state (step 0, or the recovered one), latched
   lastReportAt_ = ros::WallTime::now();
-  // Every 2.5 s (a waiting line every 5 s at most): a manager holds hundreds of agents, and each
-  // roscpp timer that fires costs a search through all the process's timers.
-  watchTimer_ = nh_.createWallTimer(ros::WallDuration(kReportEvery / 2), [this](const ros::WallTimerEvent&) { reportWaiting(); });
+  // Every 2.5 s (a waiting line every 5 s at most), from the process's one PeriodicCall thread:
+  // a manager holds up to thousands of agents, and a roscpp timer each would stall it.
+  watch_ = PeriodicCall(nh_.getCallbackQueue(), kReportEvery / 2, [this] { reportWaiting(); });
 }
 
 int AgentNode::run() {

@@ -14,15 +14,13 @@ A second case SIGKILLs one agent on host B at a seeded random step, with respawn
 expects the same (it needs crash recovery in the agent and the monitor). A third loads
 launch/examples/several_hosts.launch (machine tags) and checks that it puts one agent on each robot.
 
-Without permission for `ip netns` (not root) the test fails, saying so.
+Without permission for `ip netns` (not root) the test fails, saying so. The hosts, the probes
+that run inside them and the step watcher are vf_netns.py's, shared with sharded_test.py.
 
   multihost_test.py [--gtest_output=xml:PATH]      the tests (rosunit)
   multihost_test.py --benchmark [--steps N]        lockstep throughput, 3 hosts against 1 host
 """
 import argparse
-import contextlib
-import fcntl
-import json
 import os
 import random
 import re
@@ -39,6 +37,7 @@ import rospkg
 import yaml
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import vf_netns  # noqa: E402
 import vf_rostest  # noqa: E402
 
 PKG = vf_rostest.PKG
@@ -59,58 +58,9 @@ def host_of(agent):
     return next(h for h, ids in AGENTS_ON.items() if agent in ids)
 
 
-IP = shutil.which("ip") or next((p for p in ("/usr/sbin/ip", "/sbin/ip") if os.path.exists(p)), "ip")
-
-
-def ip(*args, check=True):
-    return subprocess.run([IP, *args], capture_output=True, text=True, check=check)
-
-
-def kill_group(*procs, timeout=15.0):
-    """SIGINT to process groups we started (roslaunch shuts its nodes down), all at once, then
-    SIGKILL to those still there after `timeout` seconds."""
-    running = [p for p in procs if p.poll() is None]
-    for proc in running:
-        with contextlib.suppress(ProcessLookupError):
-            os.killpg(proc.pid, signal.SIGINT)
-    end = time.time() + timeout
-    for proc in running:
-        try:
-            proc.wait(timeout=max(0.1, end - time.time()))
-        except subprocess.TimeoutExpired:
-            with contextlib.suppress(ProcessLookupError):
-                os.killpg(proc.pid, signal.SIGKILL)
-            proc.wait(timeout=5)
-
-
-def descendants(pid):
-    """Every process below `pid`, by the parent ids in /proc."""
-    children = {}
-    for entry in os.listdir("/proc"):
-        if entry.isdigit():
-            with contextlib.suppress(OSError):
-                with open(f"/proc/{entry}/stat") as f:
-                    ppid = int(f.read().rsplit(")", 1)[1].split()[1])
-                children.setdefault(ppid, []).append(int(entry))
-    found, todo = [], [pid]
-    while todo:
-        for c in children.get(todo.pop(), []):
-            found.append(c)
-            todo.append(c)
-    return found
-
-
-def executable_of(pid):
-    with contextlib.suppress(OSError):
-        with open(f"/proc/{pid}/cmdline", "rb") as f:
-            return f.read().split(b"\0")[0].decode()
-    return ""
-
-
-def report(line):
-    """To the test's output: the JUnit file (rosunit captures stdout) and the console."""
-    for stream in {sys.stdout, sys.__stdout__}:
-        print(line, file=stream, flush=True)
+# The namespace hosts, their processes and the probes are shared with sharded_test.py.
+kill_group, descendants, executable_of, report = (vf_netns.kill_group, vf_netns.descendants,
+                                                  vf_netns.executable_of, vf_netns.report)
 
 
 def monitor_rate(log):
@@ -119,175 +69,17 @@ def monitor_rate(log):
     return (int(m.group(1)), float(m.group(2)), float(m.group(3))) if m else None
 
 
-class Hosts:
-    """Three hosts A, B, C: network namespaces vfmh<port>_a/_b/_c, each with `lo` up and an eth0
-    (a veth whose other end is on the bridge br0 of the namespace vfmh<port>_br). Processes run
-    in them through `ip netns exec` with that host's ROS_IP, ROS_HOSTNAME and the master on A."""
+class Hosts(vf_netns.Hosts):
+    """Three hosts A, B, C (vf_netns.Hosts): network namespaces vfmh<port>_a/_b/_c on the bridge
+    of vfmh<port>_br, at 10.213.50.1-3."""
 
     def __init__(self, port, workdir):
-        self.port, self.workdir = port, workdir
-        self.prefix = f"vfmh{port}"
-        self.ns = {h: f"{self.prefix}_{h.lower()}" for h in HOST_NUMBER}
-        self.bridge = f"{self.prefix}_br"
-        self.procs, self.logs = [], {}
-        self.master = self.lock = None
-
-    def all_namespaces(self):
-        return [self.bridge, *self.ns.values()]
-
-    def env(self, host):
-        return dict(os.environ, ROS_IP=address(host), ROS_HOSTNAME=address(host),
-                    ROS_MASTER_URI=f"http://{address('A')}:{self.port}",
-                    ROS_LOG_DIR=os.path.join(self.workdir, "ros_log"))
-
-    def up(self):
-        # One run per port at a time: a second one waits here instead of removing the first's hosts.
-        self.lock = os.open(os.path.join(tempfile.gettempdir(), f"vf_multihost_{self.port}.lock"),
-                            os.O_RDONLY | os.O_CREAT, 0o644)
-        fcntl.flock(self.lock, fcntl.LOCK_EX)
-        self.remove_namespaces()  # leftovers of an interrupted run
-        if not os.path.exists(IP) and not shutil.which(IP):
-            raise AssertionError("multihost: the `ip` command (Debian package iproute2) is missing")
-        made = ip("netns", "add", self.bridge, check=False)
-        if made.returncode != 0:
-            raise AssertionError(
-                f"multihost: cannot create a network namespace (`ip netns add {self.bridge}`: "
-                f"{made.stderr.strip()}); this test needs root (CAP_SYS_ADMIN and CAP_NET_ADMIN), as in CI")
-        ip("-n", self.bridge, "link", "set", "lo", "up")
-        ip("-n", self.bridge, "link", "add", "br0", "type", "bridge")
-        ip("-n", self.bridge, "link", "set", "br0", "up")
-        for host, ns in self.ns.items():
-            ip("netns", "add", ns)
-            port = f"v{host.lower()}"
-            ip("-n", self.bridge, "link", "add", port, "type", "veth", "peer", "name", "eth0", "netns", ns)
-            ip("-n", self.bridge, "link", "set", port, "master", "br0", "up")
-            ip("-n", ns, "link", "set", "lo", "up")
-            ip("-n", ns, "addr", "add", f"{address(host)}/24", "dev", "eth0")
-            ip("-n", ns, "link", "set", "eth0", "up")
-
-    def remove_namespaces(self):
-        present = ip("netns", "list", check=False).stdout.split()
-        for ns in self.all_namespaces():
-            if ns not in present:
-                continue
-            # Whatever still runs in it was started by an earlier run of this test: end it by id.
-            for pid in ip("netns", "pids", ns, check=False).stdout.split():
-                with contextlib.suppress(ProcessLookupError, ValueError):
-                    os.kill(int(pid), signal.SIGKILL)
-            ip("netns", "del", ns, check=False)
-
-    def down(self):
-        # The nodes first, so that they can still unregister, then the master.
-        kill_group(*[p for p in self.procs if p is not self.master])
-        kill_group(*self.procs)
-        self.remove_namespaces()
-        if self.lock is not None:
-            os.close(self.lock)
-            self.lock = None
-
-    def start(self, host, name, cmd):
-        """A process on `host`, its output in workdir/<name>.log."""
-        path = os.path.join(self.workdir, name + ".log")
-        with open(path, "w") as log:
-            proc = subprocess.Popen([IP, "netns", "exec", self.ns[host], *cmd], env=self.env(host), stdout=log,
-                                    stderr=subprocess.STDOUT, start_new_session=True)
-        self.procs.append(proc)
-        self.logs[name] = path
-        return proc
-
-    def run(self, host, cmd, timeout):
-        return subprocess.run([IP, "netns", "exec", self.ns[host], *cmd], env=self.env(host), capture_output=True,
-                              text=True, timeout=timeout)
-
-    def log(self, name, tail=3000):
-        with open(self.logs[name], errors="replace") as f:
-            text = re.sub(r"\x1b\[[0-9;]*m|\x1b\]2;[^\x07]*\x07", "", f.read())
-        return text[-tail:] if tail else text
-
-    def probe(self, *args, timeout=30.0):
-        """This script's --probe mode on host A (the test itself runs outside the hosts)."""
-        run = self.run("A", ["/usr/bin/python3", os.path.abspath(__file__), "--probe", *args], timeout)
-        if run.returncode != 0:
-            raise AssertionError(f"probe {args} on host A failed: {run.stdout[-2000:]}{run.stderr[-2000:]}")
-        return json.loads(run.stdout.strip().splitlines()[-1])
-
-    def start_master(self):
-        self.master = self.start("A", "roscore", ["roscore", "-p", str(self.port)])
-        self.probe("master", timeout=40.0)
+        super().__init__(port, workdir, SUBNET, HOST_NUMBER, prefix="vfmh", label="multihost")
 
     def start_agents(self, scenario, *extra):
         return {i: self.start(host, f"agent_{i}", ["roslaunch", PKG, "agent.launch", f"id:={i}",
                                                    f"scenario:={scenario}", *extra])
                 for host, ids in AGENTS_ON.items() for i in ids}
-
-
-# --- Probes: run on host A, print one JSON line --------------------------------------------------
-
-def probe_master(timeout=35.0):
-    import rosgraph
-    end = time.time() + timeout
-    while True:
-        try:
-            return {"pid": rosgraph.Master("/multihost_probe").getPid()}
-        except Exception:
-            if time.time() > end:
-                raise
-            time.sleep(0.2)
-
-
-def probe_graph(names, timeout=40.0):
-    """Each node's URI and pid and its live connections (roscpp's getBusInfo), once all are up."""
-    import xmlrpc.client
-
-    import rosgraph
-    master = rosgraph.Master("/multihost_probe")
-    end = time.time() + timeout
-    out = {}
-    for name in names:
-        while True:
-            try:
-                uri = master.lookupNode(name)
-                node = xmlrpc.client.ServerProxy(uri)
-                out[name] = {"uri": uri, "pid": node.getPid("/multihost_probe")[2],
-                             "bus": node.getBusInfo("/multihost_probe")[2]}
-                break
-            except Exception:
-                if time.time() > end:
-                    raise
-                time.sleep(0.2)
-    return out
-
-
-def probe_step(topic, step, timeout):
-    """Waits until an agent's state on `topic` reaches `step`; the newest step seen."""
-    import threading
-
-    import rospy
-    from variational_formation.msg import AgentState
-    reached, seen = threading.Event(), [-1]
-
-    def on_state(msg):
-        seen[0] = max(seen[0], msg.step)
-        if seen[0] >= step:
-            reached.set()
-
-    rospy.init_node("multihost_watch", anonymous=True, disable_signals=True)
-    sub = rospy.Subscriber(topic, AgentState, on_state, queue_size=10000, tcp_nodelay=True)
-    print("watching", flush=True)
-    reached.wait(timeout)
-    print(json.dumps({"step": seen[0]}), flush=True)  # at once: rospy takes a while to shut down
-    sub.unregister()
-    return {"step": seen[0]}
-
-
-def probe_main(args):
-    if args[0] == "master":
-        result = probe_master()
-    elif args[0] == "graph":
-        result = probe_graph(args[1:])
-    else:
-        result = probe_step(args[1], int(args[2]), float(args[3]))
-    print(json.dumps(result))
 
 
 # --- The tests -----------------------------------------------------------------------------------
@@ -350,37 +142,19 @@ class MultiHost(unittest.TestCase, vf_rostest.RunChecks):
             extra.append("respawn_timeout:=20")
         if kill:
             # The watcher subscribes before the run starts, so it sees the step when it comes.
-            watcher = hosts.start("A", "watch", ["/usr/bin/python3", os.path.abspath(__file__), "--probe", "step",
-                                                 f"/formation/agent_{victim}/state", str(kill[0]), str(RUN_TIMEOUT)])
-            end = time.time() + 30
-            while "watching" not in hosts.log("watch") and watcher.poll() is None and time.time() < end:
-                time.sleep(0.1)
-            self.assertIn("watching", hosts.log("watch"), "the step watcher did not start")
+            self.assertTrue(hosts.start_watcher(f"/formation/agent_{victim}/state", kill[0], RUN_TIMEOUT),
+                            f"the step watcher did not start:\n{hosts.log('watch')}")
         out = os.path.join(self.tmp, "out")
         run = hosts.start("A", "formation", ["rosrun", PKG, "run_formation.sh", f"scenario:={SCENARIO}",
                                              "agents:=false", "record:=true", f"output_dir:={out}", *extra])
         if kill:
-            end = time.time() + RUN_TIMEOUT + 10
-            while not re.search(r"^\{.*\}$", hosts.log("watch"), re.M) and time.time() < end:
-                time.sleep(0.01)
-            found = re.search(r"^\{.*\}$", hosts.log("watch"), re.M)
-            self.assertTrue(found, f"the step watcher said nothing:\n{hosts.log('watch')}\n{hosts.log('formation')}")
-            seen = json.loads(found.group(0))["step"]
+            seen = hosts.watched_step(RUN_TIMEOUT + 10)
+            self.assertIsNotNone(seen, f"the step watcher said nothing:\n{hosts.log('watch')}\n{hosts.log('formation')}")
             self.assertGreaterEqual(seen, kill[0], f"the run did not reach step {kill[0]}:\n{hosts.log('formation')}")
             self.assertLess(seen, int(self.scenario["steps"]), "the watcher saw the step only after the run")
             kill[1](agents, seen)
-        timeout = RUN_TIMEOUT
-        try:
-            run.wait(timeout=timeout)
-            late = ""
-        except subprocess.TimeoutExpired:
-            kill_group(run)  # the monitor writes why it was still waiting
-            late = f"the run did not end within {timeout:.0f} s; "
-        result_path = os.path.join(out, SCENARIO + ".result.yaml")
-        result = {}
-        if os.path.exists(result_path):
-            with open(result_path) as f:
-                result = yaml.safe_load(f) or {}
+        # On a timeout the run is ended: the monitor writes why it was still waiting.
+        result, late = vf_netns.finish_run(run, os.path.join(out, SCENARIO + ".result.yaml"), RUN_TIMEOUT)
         victim_log = f"\nagent_{victim}'s roslaunch:\n{hosts.log(f'agent_{victim}', 1500)}" if kill else ""
         self.assertEqual(result.get("result"), "succeeded",
                          f"{late}result file: {result}\n{hosts.log('formation')}{victim_log}")
@@ -525,7 +299,7 @@ def bench_one(path, run_dir):
 
 if __name__ == "__main__":
     if len(sys.argv) > 1 and sys.argv[1] == "--probe":
-        probe_main(sys.argv[2:])
+        vf_netns.probe_main(sys.argv[2:])
         sys.exit(0)
     if len(sys.argv) > 1 and sys.argv[1] == "--benchmark":
         parser = argparse.ArgumentParser(description="lockstep throughput: 3 namespace hosts against 1 host")

@@ -14,6 +14,7 @@
 #include "variational_formation/RecallHistory.h"
 #include "variational_formation/RecallState.h"
 #include "variational_formation/RunProgress.h"
+#include "variational_formation/ros/periodic_call.hpp"
 #include "variational_formation/ros/participants.hpp"
 #include "variational_formation/core/lockstep_agent.hpp"
 
@@ -97,7 +98,7 @@ class AgentNode {
   long startStep_ = 0;
   std::string monitor_;
   tf2_ros::TransformBroadcaster tf_;
-  ros::WallTimer paceTimer_, watchTimer_;
+  ros::WallTimer paceTimer_;
   double realTimeFactor_ = 0.0;
   long allowedStep_ = 0;
   bool started_ = false;
@@ -105,6 +106,9 @@ class AgentNode {
   long dropped_ = 0;
   int exitStatus_ = -1;  // -1: running
   std::string name_, frame_, failure_, worldFrame_;
+  // The waiting line (not a roscpp timer: one per agent of a manager is costly). Last, so that it
+  // stops, and a call in progress ends, before any member it reads goes.
+  PeriodicCall watch_;
 };
 
 }  // namespace vf
