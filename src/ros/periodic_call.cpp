@@ -7,8 +7,6 @@
 #include <set>
 #include <thread>
 
-#include <boost/make_shared.hpp>
-
 namespace vf {
 
 using Clock = std::chrono::steady_clock;
@@ -79,7 +77,7 @@ class Ticker {
         if (e->due <= now) {
           if (!e->queued) {
             e->queued = true;
-            e->queue->addCallback(boost::make_shared<Call>(e), reinterpret_cast<uint64_t>(e));
+            e->queue->addCallback(ros::CallbackInterfacePtr(new Call(e)), reinterpret_cast<uint64_t>(e));
           }
           while (e->due <= now) e->due += e->period;
         }

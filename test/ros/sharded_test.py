@@ -8,7 +8,7 @@ ROS_IP / ROS_HOSTNAME:
 - host A (10.213.51.1): roscore and `run_formation.sh agents:=false record:=true
   agent_manager:="manager_b manager_c manager_d"` (the monitor and the recorder);
 - hosts B, C, D (10.213.51.2-4): agents 0-19, 20-39, 40-59, each third in one respawning
-  agent_manager (formation/manager_b, _c, _d), from the launch file `make_agents_launch.py
+  agent_manager (formation/manager_b, _c, _d), loaded by the launch file that `make_agents_launch.py
   --nodelet true --ids ... --manager-name ... --agent-manager ...` writes on that host.
 
 Case `run`: the run succeeds; the bag is complete and equals simulate bit for bit (every state,
@@ -159,7 +159,7 @@ class Sharded(unittest.TestCase, vf_rostest.RunChecks):
 
     def check_batched(self, hosts, graph, managers, when):
         """Each node of `graph` (the monitor, the recorder: host A) takes every agent's states
-        from the managers' batches: a live inbound connection on each manager's `states` from
+        out of the managers' batches: a live inbound connection on each manager's `states` from
         that manager (its URI: one of the graph entries in `managers`, by host) at its host's
         address, and none on an agent's own topic."""
         for node, info in sorted(graph.items()):
