@@ -82,6 +82,27 @@ class MakeAgentsLaunchTest(TempDirTestCase):
                                             self.path("a.launch"), "--loss", "2"), "loss", "probability")
         self.assertFalse(os.path.exists(self.path("a.launch")))
 
+    def test_one_machines_share_in_a_named_manager(self):
+        out = self.path("shard.launch")
+        self.assertSucceeded(self.run_script("make_agents_launch.py", "--scenario", HEXAGON, "--out", out, "--nodelet",
+                                             "true", "--ids", "4-5,1", "--manager-name", "manager_b",
+                                             "--agent-manager", "manager_a manager_b"))
+        nodes = ElementTree.parse(out).getroot().findall("node")
+        self.assertEqual([n.get("name") for n in nodes], ["manager_b"])
+        params = {p.get("name"): p.get("value") for p in nodes[0].findall("param")}
+        self.assertEqual(params["agents"], "4 5 1")
+        self.assertEqual(params["agent_manager"], "manager_a manager_b")
+
+    def test_bad_share(self):
+        launch = ("make_agents_launch.py", "--scenario", HEXAGON, "--out", self.path("a.launch"))
+        self.assertBadInput(self.run_script(*launch, "--nodelet", "true", "--ids", "0-6"), "ids", "agent 6",
+                            "6 agents")
+        self.assertBadInput(self.run_script(*launch, "--nodelet", "true", "--ids", "3-1"), "ids", "empty range")
+        self.assertBadInput(self.run_script(*launch, "--nodelet", "true", "--ids", "a"), "ids")
+        self.assertBadInput(self.run_script(*launch, "--nodelet", "true", "--manager-name", "b/c"), "manager_name")
+        self.assertBadInput(self.run_script(*launch, "--manager-name", "manager_b"), "only with nodelet true")
+        self.assertFalse(os.path.exists(self.path("a.launch")))
+
 
 class XwdToPngTest(TempDirTestCase):
     def write_xwd(self, path, pixels):
