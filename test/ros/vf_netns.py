@@ -221,10 +221,11 @@ class Hosts:
     def answer(self, name, timeout):
         """The JSON line a probe started with start() printed, once it has (None: not within
         `timeout` seconds)."""
+        # The whole log: the JSON line may be longer than log()'s usual tail.
         end = time.time() + timeout
-        while not re.search(r"^\{.*\}$", self.log(name), re.M) and time.time() < end:
+        while not re.search(r"^\{.*\}$", self.log(name, 0), re.M) and time.time() < end:
             time.sleep(0.01)
-        found = re.search(r"^\{.*\}$", self.log(name), re.M)
+        found = re.search(r"^\{.*\}$", self.log(name, 0), re.M)
         return json.loads(found.group(0)) if found else None
 
 
