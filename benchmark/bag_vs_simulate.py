@@ -31,11 +31,8 @@ def main():
     n, steps = scenario["n"], int(scenario["steps"])
     expected = vf_rostest.simulate(args.scenario)
     seen, differ, twice = set(), 0, 0
-    parts, stem = [args.bag], args.bag[:-len(".bag")]
-    while os.path.exists(f"{stem}_{len(parts)}.bag"):
-        parts.append(f"{stem}_{len(parts)}.bag")
     prefix = args.ns + "/agent_"
-    for part in parts:
+    for part in vf_rostest.bag_parts(args.bag):
         with rosbag.Bag(part) as bag:
             for _, msg, _ in bag.read_messages(
                     connection_filter=lambda topic, *_: topic.startswith(prefix) and topic.endswith("/state")):

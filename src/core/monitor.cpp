@@ -89,21 +89,19 @@ std::vector<FormationSnapshot> FormationMonitor::takeCompleted() {
 
 namespace {
 
-/// v_i - (v* + omega* x (q_i - c)), c the centroid of q: the velocities in the frame the command
-/// moves (v itself when the command does not move the formation).
-Velocities relativeToCommand(const Command& command, const Positions& q, const Velocities& v) {
-  if (command.velocity.isZero(0.0) && !command.rotates()) return v;
+/// v_i -= v* + omega* x (q_i - c), c the centroid of q: the velocities in the frame the command
+/// moves (untouched when the command does not move the formation).
+void subtractCommandedMotion(const Command& command, const Positions& q, Velocities& v) {
+  if (command.velocity.isZero(0.0) && !command.rotates()) return;
   const int d = static_cast<int>(q.rows());
   Vector3 centroid = Vector3::Zero();
   centroid.head(d) = q.rowwise().mean();
-  Velocities relative = v;
   for (Eigen::Index i = 0; i < q.cols(); ++i) {
     Vector3 r = Vector3::Zero();
     r.head(d) = q.col(i);
     const Vector3 u = command.velocity + command.angularRate.cross(r - centroid);
-    relative.col(i) -= u.head(d);
+    v.col(i) -= u.head(d);
   }
-  return relative;
 }
 
 }  // namespace
@@ -136,7 +134,8 @@ FormationSnapshot FormationMonitor::measureStep(long step, const Positions& qPre
   s.edgeDistanceErrors = formation_.distanceErrors(q, scale);
   s.scale = scale;
   s.positions = q;
-  s.converged = congruence_.check(formation_, q, relativeToCommand(command, q, v), scale);
+  subtractCommandedMotion(command, q, v);  // v is not used after this
+  s.converged = congruence_.check(formation_, q, v, scale);
   if (!s.converged) {
     congruentSince_ = -1;
   } else if (congruentSince_ < 0) {

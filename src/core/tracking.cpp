@@ -57,8 +57,6 @@ double meanScaleError(const Formation& formation, const Positions& q, double sca
   return counted == 0 ? 0.0 : sum / static_cast<double>(counted) - scale;
 }
 
-
-
 CommandedFrame commandedFrame(const CommandSchedule& schedule, long step, double timeStep) {
   CommandedFrame frame;
   const Command& now = schedule.at(step);

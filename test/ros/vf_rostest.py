@@ -134,6 +134,15 @@ def agent_colour_pixels(image):
     return counts
 
 
+def bag_parts(bag_path):
+    """The files of one recording: <name>.bag, then <name>_1.bag, ... while they exist (a long run
+    is split by record_split_size)."""
+    parts, stem = [bag_path], bag_path[:-len(".bag")] if bag_path.endswith(".bag") else bag_path
+    while os.path.exists(f"{stem}_{len(parts)}.bag"):
+        parts.append(f"{stem}_{len(parts)}.bag")
+    return parts
+
+
 class Recording:
     """Everything a bag of formation.launch record:=true holds, by agent and step."""
 
@@ -146,11 +155,7 @@ class Recording:
         # write order across chunks, so a late write shows up here).
         self.out_of_order = []
         last = None
-        # A long run is split into <name>.bag, <name>_1.bag, ... (record_split_size): read them all.
-        parts, stem = [bag_path], bag_path[:-len(".bag")] if bag_path.endswith(".bag") else bag_path
-        while os.path.exists(f"{stem}_{len(parts)}.bag"):
-            parts.append(f"{stem}_{len(parts)}.bag")
-        for part in parts:
+        for part in bag_parts(bag_path):
             with rosbag.Bag(part) as bag:
                 for topic, msg, t in bag.read_messages():
                     if last is not None and t < last:

@@ -62,7 +62,6 @@ class FormationMonitor {
    * commanded motion v* + omega* x (q_i - c), c the centroid. Steps already measured keep theirs.
    */
   void setSchedule(const CommandSchedule& schedule) { schedule_ = schedule; }
-  const CommandSchedule& schedule() const { return schedule_; }
 
   long nextStep() const { return next_; }
   const Formation& formation() const { return formation_; }

@@ -25,7 +25,6 @@ Vector3 rotationRate(const Positions& q, const Velocities& v, double timeStep);
 /// negative while the formation is smaller than commanded. 0 without edges.
 double meanScaleError(const Formation& formation, const Positions& q, double scale);
 
-
 /// max over edges of | |q_i - q_j| - s d_ij | [m]: Formation::maxDistanceError(q, s).
 inline double maxScaledDistanceError(const Formation& formation, const Positions& q, double scale) {
   return formation.maxDistanceError(q, scale);
