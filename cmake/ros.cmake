@@ -53,29 +53,22 @@ if(CATKIN_ENABLE_TESTING)
     "scenario:=grid24 nodelet:=true"
     # Scale: a 3D lattice of 48 agents written by make_scenario, all in one manager.
     "scenario:=lattice48 nodelet:=true")
-  foreach(case ${VF_RUN_CASES})
-    separate_arguments(args UNIX_COMMAND "${case}")
-    add_rostest(test/ros/distributed_run.test ARGS ${args})
-  endforeach()
+  vf_add_rostest_cases(test/ros/distributed_run.test ${VF_RUN_CASES})
   # Real faults (signals to the real processes) during recorded runs: test/ros/fault.test.
-  foreach(case "fault:=kill_agent seed:=3" "fault:=kill_agent_twice seed:=5" "fault:=kill_two seed:=2"
-               "fault:=stop_agent seed:=4" "fault:=kill_monitor seed:=6" "fault:=kill_recorder seed:=7"
-               # 20 kills of one agent, unpaced: a state of a dead incarnation may be held only by
-               # its neighbours (doc/distributed.md, recovery).
-               "fault:=kill_agent kills:=20 seed:=17 rate:=0 test_scenario:=hexagon3000")
-    separate_arguments(args UNIX_COMMAND "${case}")
-    add_rostest(test/ros/fault.test ARGS ${args})
-  endforeach()
+  vf_add_rostest_cases(test/ros/fault.test
+    "fault:=kill_agent seed:=3" "fault:=kill_agent_twice seed:=5" "fault:=kill_two seed:=2"
+    "fault:=stop_agent seed:=4" "fault:=kill_monitor seed:=6" "fault:=kill_recorder seed:=7"
+    # 20 kills of one agent, unpaced: a state of a dead incarnation may be held only by its
+    # neighbours (doc/distributed.md, recovery).
+    "fault:=kill_agent kills:=20 seed:=17 rate:=0 test_scenario:=hexagon3000")
   # Time-driven agents (test/ros/timed_run.test), hexagon at rate 1.
-  foreach(case "case:=no_faults" "case:=faults delay:=0.05 jitter:=0.02 loss:=0.2"
-               "case:=within_margin scenario_name:=timed_hexagon_kappa4"
-               "case:=beyond_margin scenario_name:=timed_hexagon_kappa4 expect:=not_converged delay:=0.07"
-               "case:=kill kill:=2 respawn_delay:=1.5"
-               "case:=reconfigure scenario_name:=timed_hexagon_kappa4 delay:=0.07 reconfigure_kappa:=13"
-               "case:=command command:=0.3_-0.2")
-    separate_arguments(args UNIX_COMMAND "${case}")
-    add_rostest(test/ros/timed_run.test ARGS ${args})
-  endforeach()
+  vf_add_rostest_cases(test/ros/timed_run.test
+    "case:=no_faults" "case:=faults delay:=0.05 jitter:=0.02 loss:=0.2"
+    "case:=within_margin scenario_name:=timed_hexagon_kappa4"
+    "case:=beyond_margin scenario_name:=timed_hexagon_kappa4 expect:=not_converged delay:=0.07"
+    "case:=kill kill:=2 respawn_delay:=1.5"
+    "case:=reconfigure scenario_name:=timed_hexagon_kappa4 delay:=0.07 reconfigure_kappa:=13"
+    "case:=command command:=0.3_-0.2")
   add_rostest(test/ros/timed_bad_input.test)
   # Live commands in a recorded lockstep run (test/ros/manoeuvre_run.test): with bad ones; with
   # an agent and the monitor killed during the manoeuvre.
@@ -88,16 +81,14 @@ if(CATKIN_ENABLE_TESTING)
   target_compile_options(test_call_pool PRIVATE ${VF_FLAGS})
   # Simulated robots (test/ros/robots_run.test): the hexagon with holonomic robots and with
   # unicycles from seeded headings; ring7 (delay margin 0.05 s) with lags 0.1 and 0.3 s.
-  foreach(case "case:=hexagon"
-               "case:=hexagon_unicycle kinematics:=unicycle heading_seed:=7 world_frame:=map"
-               "case:=hexagon_unicycle_command kinematics:=unicycle heading_seed:=9 command:=0.3_-0.2"
-               "case:=ring7_lag01 scenario:=ring7 lag:=0.1 time_limit:=90 expect_lag_warning:=true"
-               "case:=ring7_lag03 scenario:=ring7 lag:=0.3 time_limit:=90 expect_lag_warning:=true"
-               "case:=ring7_unicycle_lag01 scenario:=ring7 lag:=0.1 kinematics:=unicycle heading_seed:=3 time_limit:=90 expect_lag_warning:=true"
-               "case:=ring7_unicycle_lag03 scenario:=ring7 lag:=0.3 kinematics:=unicycle heading_seed:=5 time_limit:=90 expect_lag_warning:=true")
-    separate_arguments(args UNIX_COMMAND "${case}")
-    add_rostest(test/ros/robots_run.test ARGS ${args})
-  endforeach()
+  vf_add_rostest_cases(test/ros/robots_run.test
+    "case:=hexagon"
+    "case:=hexagon_unicycle kinematics:=unicycle heading_seed:=7 world_frame:=map"
+    "case:=hexagon_unicycle_command kinematics:=unicycle heading_seed:=9 command:=0.3_-0.2"
+    "case:=ring7_lag01 scenario:=ring7 lag:=0.1 time_limit:=90 expect_lag_warning:=true"
+    "case:=ring7_lag03 scenario:=ring7 lag:=0.3 time_limit:=90 expect_lag_warning:=true"
+    "case:=ring7_unicycle_lag01 scenario:=ring7 lag:=0.1 kinematics:=unicycle heading_seed:=3 time_limit:=90 expect_lag_warning:=true"
+    "case:=ring7_unicycle_lag03 scenario:=ring7 lag:=0.3 kinematics:=unicycle heading_seed:=5 time_limit:=90 expect_lag_warning:=true")
   # render_bag.py on a recorded hexagon: video length, frames, processes left, bad inputs.
   add_rostest(test/ros/render.test)
   # SIGKILL to the nodelet manager of every agent during a recorded run: test/ros/nodelet_fault.test.

@@ -2,29 +2,15 @@
 if(CATKIN_ENABLE_TESTING)
   set(VF_CORE_TESTS formation integrators metrics stability scenario free_particle lockstep simulation
     timed_agent link_faults point_robot unicycle_robot record_ledger layers manoeuvre lockstep_manoeuvre monitor)
-  foreach(name ${VF_CORE_TESTS})
-    catkin_add_gtest(test_${name} test/core/test_${name}.cpp)
-    target_link_libraries(test_${name} variational_formation_core gtest_main)
-    target_compile_options(test_${name} PRIVATE ${VF_FLAGS})
-    target_compile_definitions(test_${name} PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  foreach(name ${VF_CORE_TESTS} command_desk)
+    vf_add_gtest(test_${name} test/core/test_${name}.cpp variational_formation_core)
   endforeach()
-  # The protocol's event sequences and seeded interleavings, over shipped and generated formations.
-  catkin_add_gtest(test_command_desk test/core/test_command_desk.cpp)
-  target_link_libraries(test_command_desk variational_formation_core gtest_main)
-  target_compile_options(test_command_desk PRIVATE ${VF_FLAGS})
-  target_compile_definitions(test_command_desk PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
-  catkin_add_gtest(test_protocol test/core/test_protocol.cpp)
-  target_link_libraries(test_protocol variational_formation_tools gtest_main)
-  target_compile_options(test_protocol PRIVATE ${VF_FLAGS})
-  target_compile_definitions(test_protocol PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
-  catkin_add_gtest(test_simulate_cli test/tools/test_simulate_cli.cpp)
-  target_link_libraries(test_simulate_cli variational_formation_tools gtest_main)
-  target_compile_options(test_simulate_cli PRIVATE ${VF_FLAGS})
-  target_compile_definitions(test_simulate_cli PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
-  catkin_add_gtest(test_simulate_manoeuvre test/tools/test_simulate_manoeuvre.cpp)
-  target_link_libraries(test_simulate_manoeuvre variational_formation_tools gtest_main)
-  target_compile_options(test_simulate_manoeuvre PRIVATE ${VF_FLAGS})
-  target_compile_definitions(test_simulate_manoeuvre PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  # The protocol's event sequences and seeded interleavings, over shipped and generated formations
+  # (test_command_desk above, and test_protocol, which generates formations with the tools).
+  vf_add_gtest(test_protocol test/core/test_protocol.cpp variational_formation_tools)
+  foreach(name simulate_cli simulate_manoeuvre)
+    vf_add_gtest(test_${name} test/tools/test_${name}.cpp variational_formation_tools)
+  endforeach()
 endif()
 
 # The documentation against the code (test/doc/test_docs.py): doc/ros_api.md lists exactly the

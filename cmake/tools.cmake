@@ -10,35 +10,18 @@ target_link_libraries(variational_formation_tools PUBLIC variational_formation_c
 target_sources(variational_formation_tools PRIVATE src/tools/scenario_path.cpp)
 target_compile_options(variational_formation_tools PRIVATE ${VF_FLAGS})
 
-add_executable(simulate src/tools/simulate_main.cpp)
-target_link_libraries(simulate variational_formation_tools)
-target_compile_options(simulate PRIVATE ${VF_FLAGS})
-install(TARGETS simulate variational_formation_tools
-  RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION}
+vf_add_tool(simulate src/tools/simulate_main.cpp)
+install(TARGETS variational_formation_tools
   ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
 
-add_executable(scenario_info src/tools/scenario_info_main.cpp)
-target_link_libraries(scenario_info variational_formation_tools)
-target_compile_options(scenario_info PRIVATE ${VF_FLAGS})
-install(TARGETS scenario_info RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+vf_add_tool(scenario_info src/tools/scenario_info_main.cpp)
 
 # make_scenario: generated rigid formations (grids, rings, lattices, Henneberg) of any size.
 target_sources(variational_formation_tools PRIVATE
   src/tools/formation_generators.cpp
   src/tools/make_scenario_cli.cpp
 )
-add_executable(make_scenario src/tools/make_scenario_main.cpp)
-target_link_libraries(make_scenario variational_formation_tools)
-target_compile_options(make_scenario PRIVATE ${VF_FLAGS})
-install(TARGETS make_scenario RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
-if(CATKIN_ENABLE_TESTING)
-  catkin_add_gtest(test_make_scenario test/tools/test_make_scenario.cpp)
-  target_link_libraries(test_make_scenario variational_formation_tools gtest_main)
-  target_compile_options(test_make_scenario PRIVATE ${VF_FLAGS})
-  target_compile_definitions(test_make_scenario PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
-  catkin_add_gtest(test_scenario_path test/tools/test_scenario_path.cpp)
-  target_link_libraries(test_scenario_path variational_formation_tools gtest_main)
-  target_compile_options(test_scenario_path PRIVATE ${VF_FLAGS})
-  target_compile_definitions(test_scenario_path PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
-endif()
+vf_add_tool(make_scenario src/tools/make_scenario_main.cpp)
+vf_add_gtest(test_make_scenario test/tools/test_make_scenario.cpp variational_formation_tools)
+vf_add_gtest(test_scenario_path test/tools/test_scenario_path.cpp variational_formation_tools)

@@ -33,6 +33,12 @@ void requireFiniteAbove(const std::string& field, double value, double lower, co
   if (!std::isfinite(value) || !(value > lower)) reject(field, "finite and > " + formatNumber(lower), unit, value);
 }
 
+void requireRobotLimits(double lag, double maxSpeed, double odometryNoise) {
+  requireFiniteAtLeast("lag", lag, 0.0, "s");
+  requireFiniteAbove("max_speed", maxSpeed, 0.0, "m/s");
+  requireFiniteAtLeast("odometry_noise", odometryNoise, 0.0, "m");
+}
+
 void requireFiniteWithin(const std::string& field, double value, double lower, double upper,
                          const std::string& unit) {
   if (!std::isfinite(value) || value < lower || value > upper) {

@@ -29,10 +29,8 @@ void checkVector(const char* field, const std::vector<double>& x, std::size_t si
 }  // namespace
 
 void validatePointRobot(const PointRobotSettings& settings) {
-  requireFiniteAtLeast("lag", settings.lag, 0.0, "s");
-  requireFiniteAbove("max_speed", settings.maxSpeed, 0.0, "m/s");
+  requireRobotLimits(settings.lag, settings.maxSpeed, settings.odometryNoise);
   requireFiniteAbove("max_acceleration", settings.maxAcceleration, 0.0, "m/s^2");
-  requireFiniteAtLeast("odometry_noise", settings.odometryNoise, 0.0, "m");
 }
 
 PointRobot::PointRobot(const PointRobotSettings& settings, const std::vector<double>& initialPosition,

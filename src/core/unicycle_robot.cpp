@@ -19,10 +19,8 @@ constexpr double kWeights[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
 }  // namespace
 
 void validateUnicycleRobot(const UnicycleRobotSettings& settings) {
-  requireFiniteAtLeast("lag", settings.lag, 0.0, "s");
-  requireFiniteAbove("max_speed", settings.maxSpeed, 0.0, "m/s");
+  requireRobotLimits(settings.lag, settings.maxSpeed, settings.odometryNoise);
   requireFiniteAbove("max_turn_rate", settings.maxTurnRate, 0.0, "rad/s");
-  requireFiniteAtLeast("odometry_noise", settings.odometryNoise, 0.0, "m");
   requireFiniteAtLeast("heading_noise", settings.headingNoise, 0.0, "rad");
 }
 

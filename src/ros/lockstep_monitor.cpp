@@ -101,9 +101,15 @@ void LockstepMonitor::updateProgress() {
     return;
   }
   RunProgress next = toMessage(referee_->progressNow());
-  // A pending command goes out at the allowed step, before the progress that counts it.
+  // A pending command goes out at the allowed step, before the progress that counts it, and
+  // after every step whose status is out: a status counts every command stamped at or before its
+  // step, so the recorder knows which commands a step waits for (the allowed step equals the
+  // completed one while the agents wait for a lagging recorder).
   const long issuedBefore = commandsIssued();
-  next.commands = issueCommands(next.allowed_step);
+  const long published = referee_->completedStep();
+  const long last = scenario_.steps;
+  const long at = (last <= 0 || published < last) ? std::max(next.allowed_step, published + 1) : next.allowed_step;
+  next.commands = issueCommands(at);
   if (!changed && next.commands == issuedBefore) return;
   if (waiting && referee_->running()) startedAt_ = ros::WallTime::now();
   publishProgress(next);

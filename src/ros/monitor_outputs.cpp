@@ -29,6 +29,7 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
   status.header.frame_id = worldFrame_;
   status.dropped = static_cast<uint32_t>(dropped_);
   status.max_data_age = dataAge;
+  status.commands = static_cast<uint32_t>(commandsIssued());
   if (!noetherHolds) {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     status.linear_momentum_predicted.x = status.linear_momentum_predicted.y = status.linear_momentum_predicted.z = nan;

@@ -63,7 +63,12 @@ void RecorderNode::write(const std::string& topic, const M& msg, const ros::Time
 void RecorderNode::flush() {
   // Steps are written whole and in order, so the bag's messages are in time order: readers that
   // trust it (Python's rosbag merges chunks assuming it) see every stream in step order.
-  for (const Steps::Step& step : steps_->takeWhole()) {
+  // A step waits for every command its status counts (the monitor stamps none at or before a
+  // step whose status is out): the list comes on its own connection, possibly after the status.
+  const auto commandsHeld = [this](const Steps::Step& step) {
+    return commands_.commands.size() >= step.status->commands;
+  };
+  for (const Steps::Step& step : steps_->takeWhole(commandsHeld)) {
     writeCommandsUpTo(step.step);
     for (std::size_t i = 0; i < step.states.size(); ++i) {
       const AgentState& msg = *step.states[i];

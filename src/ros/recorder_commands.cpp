@@ -36,9 +36,13 @@ void RecorderNode::onCommands(const ros::MessageEvent<variational_formation::For
                       event.getPublisherName().c_str(), monitor_.c_str());
     return;
   }
+  // The list only grows (a restarted monitor goes on from the kept one): an older copy that
+  // arrives late changes nothing.
+  if (event.getConstMessage()->commands.size() < commands_.commands.size()) return;
   commands_ = *event.getConstMessage();
   commandsInBag_ = std::min(commandsInBag_, commands_.commands.size());
   writeCommandsFile();
+  flush();  // steps that waited for these commands
 }
 
 void RecorderNode::writeCommandsFile() const {

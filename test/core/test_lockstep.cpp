@@ -6,6 +6,7 @@
 #include <functional>
 #include <random>
 
+#include "lockstep_delivery.hpp"
 #include "test_support.hpp"
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/lockstep_agent.hpp"
@@ -14,12 +15,6 @@
 
 namespace vf {
 namespace {
-
-struct Message {
-  int sender;
-  long step;
-  std::vector<double> q, qPrev;
-};
 
 void runDistributed(const std::string& name, unsigned seed) {
   Scenario s = loadScenario(test::configPath(name));
@@ -35,37 +30,8 @@ void runDistributed(const std::string& name, unsigned seed) {
     expected.push_back(reference.positions());
   }
   std::mt19937 rng(seed);
-  std::vector<Message> inFlight;
-  const auto broadcast = [&](const LockstepAgent& a) {
-    inFlight.push_back({a.id(), a.step(), a.position(), a.previousPosition()});
-  };
-  for (const auto& a : agents) broadcast(a);
   long checked = 0;
-  while (true) {
-    bool allDone = true;
-    for (const auto& a : agents) allDone = allDone && a.finished();
-    if (allDone) break;
-    ASSERT_FALSE(inFlight.empty()) << "deadlock";
-    // Deliver a random in-flight state to every agent: states of one sender may overtake each
-    // other, and an overtaken one is refused as "going back", a loss that the newer state
-    // (which carries q_{m-1}) makes good.
-    std::uniform_int_distribution<std::size_t> pick(0, inFlight.size() - 1);
-    const std::size_t m = pick(rng);
-    const Message msg = inFlight[m];
-    inFlight.erase(inFlight.begin() + static_cast<long>(m));
-    for (auto& a : agents) {
-      a.receive(msg.sender, msg.step, msg.q, msg.qPrev);
-      while (!a.finished() && a.ready()) {
-        a.advance();
-        for (int c = 0; c < s.dimension; ++c) {
-          ASSERT_EQ(a.position()[c], expected[static_cast<std::size_t>(a.step())](c, a.id()))
-              << name << " agent " << a.id() << " step " << a.step();
-        }
-        ++checked;
-        broadcast(a);
-      }
-    }
-  }
+  test::runInRandomOrder(agents, expected, rng, name, &checked);
   EXPECT_EQ(checked, s.steps * s.agentCount());
 }
 

@@ -6,18 +6,13 @@
 
 #include <random>
 
+#include "lockstep_delivery.hpp"
 #include "test_support.hpp"
 #include "variational_formation/core/lockstep_agent.hpp"
 #include "variational_formation/core/manoeuvre_integrator.hpp"
 
 namespace vf {
 namespace {
-
-struct Message {
-  int sender;
-  long step;
-  std::vector<double> q, qPrev;
-};
 
 using test::command;
 
@@ -45,33 +40,8 @@ void runDistributed(const Scenario& s, const CommandSchedule& broadcast, const C
       ASSERT_EQ(a.receiveCommand(entry.first, entry.second), LockstepAgent::CommandReceipt::Accepted);
     }
   };
-  std::vector<Message> inFlight;
-  for (const auto& a : agents) inFlight.push_back({a.id(), a.step(), a.position(), a.previousPosition()});
   long checked = 0;
-  while (true) {
-    bool allDone = true;
-    for (const auto& a : agents) allDone = allDone && a.finished();
-    if (allDone) break;
-    ASSERT_FALSE(inFlight.empty()) << "deadlock";
-    std::uniform_int_distribution<std::size_t> pick(0, inFlight.size() - 1);
-    const std::size_t m = pick(rng);
-    const Message msg = inFlight[m];
-    inFlight.erase(inFlight.begin() + static_cast<long>(m));
-    for (auto& a : agents) {
-      a.receive(msg.sender, msg.step, msg.q, msg.qPrev);
-      deliverDue(a);
-      while (!a.finished() && a.ready()) {
-        a.advance();
-        for (int c = 0; c < s.dimension; ++c) {
-          ASSERT_EQ(a.position()[c], expected[static_cast<std::size_t>(a.step())](c, a.id()))
-              << s.name << " agent " << a.id() << " step " << a.step();
-        }
-        ++checked;
-        inFlight.push_back({a.id(), a.step(), a.position(), a.previousPosition()});
-        deliverDue(a);
-      }
-    }
-  }
+  test::runInRandomOrder(agents, expected, rng, s.name, &checked, deliverDue);
   EXPECT_EQ(checked, s.steps * s.agentCount());
 }
 

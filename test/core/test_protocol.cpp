@@ -135,6 +135,29 @@ TEST(StepAssembler, HandsOutWholeStepsInOrderOnce) {
   EXPECT_EQ(protocol::stepOfStamp(0.30000000000000004, 0.1), 3);
 }
 
+TEST(StepAssembler, AWholeStepWaitsForWhatItsStatusCounts) {
+  // The recorder's rule (manoeuvre_faults flake): a status counts the commands issued before it,
+  // and its step is written only once the recorder holds that many, whichever came first.
+  protocol::StepAssembler<int, int, int> a(1, [](long) { return false; });
+  std::size_t held = 0;
+  const auto commandsHeld = [&held](const protocol::StepAssembler<int, int, int>::Step& s) {
+    return held >= static_cast<std::size_t>(s.status);
+  };
+  for (long k = 0; k < 3; ++k) {
+    ASSERT_TRUE(a.addState(0, k, 0));
+    ASSERT_TRUE(a.addStatus(k, k == 0 ? 0 : 1));  // steps 1 and 2 count one command
+  }
+  const auto first = a.takeWhole(commandsHeld);
+  ASSERT_EQ(first.size(), 1u);  // step 1 waits for the command list
+  EXPECT_EQ(a.handedOutThrough(), 0);
+  EXPECT_TRUE(a.takeWhole(commandsHeld).empty());
+  held = 1;
+  const auto rest = a.takeWhole(commandsHeld);
+  ASSERT_EQ(rest.size(), 2u);
+  EXPECT_EQ(rest[0].step, 1);
+  EXPECT_EQ(a.handedOutThrough(), 2);
+}
+
 // ---- the run referee, event by event ----
 
 TEST(LockstepReferee, ProgressGoesOutWhenAgentsMayWaitAtTheAllowedStep) {

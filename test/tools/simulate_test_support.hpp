@@ -13,6 +13,9 @@
 namespace vf {
 namespace test {
 
+/// The shipped scenarios, config/ of the source tree.
+const std::string kConfig = std::string(VF_SOURCE_DIR) + "/config/";
+
 struct CliResult {
   int status;
   std::string out;

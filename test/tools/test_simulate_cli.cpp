@@ -21,11 +21,7 @@
 namespace vf {
 namespace {
 
-const std::string kConfig = std::string(VF_SOURCE_DIR) + "/config/";
-
-using test::CliResult;
-using test::simulate;
-using test::expectBadInput;
+using namespace test;  // NOLINT: the shared simulate helpers (simulate_test_support.hpp)
 
 std::vector<std::string> lines(const std::string& path) {
   std::ifstream in(path);

@@ -15,11 +15,7 @@
 namespace vf {
 namespace {
 
-const std::string kConfig = std::string(VF_SOURCE_DIR) + "/config/";
-
-using test::CliResult;
-using test::simulate;
-using test::expectBadInput;
+using namespace test;  // NOLINT: the shared simulate helpers (simulate_test_support.hpp)
 
 std::string tempPath(const std::string& name) { return ::testing::TempDir() + "vf_manoeuvre_" + name; }
 

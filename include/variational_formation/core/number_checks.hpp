@@ -16,6 +16,9 @@ void requireFiniteAbove(const std::string& field, double value, double lower, co
 /// value finite and in [lower, upper]. @throws InvalidInput
 void requireFiniteWithin(const std::string& field, double value, double lower, double upper,
                          const std::string& unit);
+/// The limits every simulated robot has (robot_sim's parameter names): lag [s] >= 0,
+/// max_speed [m/s] > 0, odometry_noise [m] >= 0, all finite. @throws InvalidInput
+void requireRobotLimits(double lag, double maxSpeed, double odometryNoise);
 /// Shortest decimal text that reads back as the same double ("0.1", "-inf", "nan").
 std::string formatNumber(double value);
 

@@ -66,13 +66,18 @@ class StepAssembler {
     p.step.markers = std::move(markers);
     return true;
   }
-  /// The whole steps that follow the last handed-out one, in order, each handed out once.
-  std::vector<Step> takeWhole() {
+  /**
+   * The whole steps that follow the last handed-out one, in order, each handed out once.
+   * @param mayHandOut what else a whole step waits for (the recorder: the commands its status
+   * counts); none if empty. The first whole step it holds back stops the hand-out there.
+   */
+  std::vector<Step> takeWhole(const std::function<bool(const Step&)>& mayHandOut = {}) {
     std::vector<Step> whole;
     while (!pending_.empty() && pending_.begin()->first == handedOut_ + 1) {
       Pending& p = pending_.begin()->second;
       const long step = pending_.begin()->first;
       if (p.stateCount < agents_ || !p.hasStatus || (needsMarkers_(step) && !p.step.hasMarkers)) break;
+      if (mayHandOut && !mayHandOut(p.step)) break;
       whole.push_back(std::move(p.step));
       pending_.erase(pending_.begin());
       handedOut_ = step;
