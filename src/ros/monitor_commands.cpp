@@ -37,7 +37,13 @@ variational_formation::FormationCommands toMessage(const std::vector<protocol::I
 
 void MonitorNode::setUpCommands(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   pnh_ = pnh;
-  desk_ = std::make_unique<protocol::CommandDesk>(scenario_);
+  // The formation's limits (doc/manoeuvres.md): beyond them a command is saturated and warned.
+  protocol::CommandLimits limits;
+  limits.maxSpeed = optionalParam(pnh, "max_speed", 2.0);
+  limits.maxTurnRate = optionalParam(pnh, "max_turn_rate", 1.0);
+  limits.minScale = optionalParam(pnh, "min_scale", 0.5);
+  limits.maxScale = optionalParam(pnh, "max_scale", 2.0);
+  desk_ = std::make_unique<protocol::CommandDesk>(scenario_, limits);
   std::istringstream names(optionalParam<std::string>(pnh, "commanders", ""));
   for (std::string name; names >> name;) commanders_.push_back(participantName(nh, name));
   commandPub_ = nh.advertise<variational_formation::FormationCommands>("command", 10, /*latch=*/true);
@@ -66,26 +72,35 @@ void MonitorNode::refuseCommand(const char* topic, const std::string& sender, co
                     why.c_str(), commandsRefused_);
 }
 
+void MonitorNode::warnCommand(const char* topic, const std::string& sender, const std::string& note) const {
+  if (note.empty()) return;
+  ROS_WARN("monitor: a command on %s from %s: %s (%ld saturated so far)", topic, sender.c_str(), note.c_str(),
+           desk_->saturated());
+}
+
 void MonitorNode::onVelocityCommand(const ros::MessageEvent<geometry_msgs::Twist const>& event) {
   const std::string sender = event.getPublisherName();
   if (ended() || !commanderAllowed(sender, "cmd_vel")) return;
   const geometry_msgs::Twist& t = *event.getConstMessage();
-  std::string why;
-  if (!desk_->offerVelocity({t.linear.x, t.linear.y, t.linear.z}, {t.angular.x, t.angular.y, t.angular.z}, why)) {
+  std::string why, note;
+  if (!desk_->offerVelocity({t.linear.x, t.linear.y, t.linear.z}, {t.angular.x, t.angular.y, t.angular.z}, why,
+                            &note)) {
     refuseCommand("cmd_vel", sender, why);
     return;
   }
+  warnCommand("cmd_vel", sender, note);
   commandOffered();
 }
 
 void MonitorNode::onScaleCommand(const ros::MessageEvent<std_msgs::Float64 const>& event) {
   const std::string sender = event.getPublisherName();
   if (ended() || !commanderAllowed(sender, "scale")) return;
-  std::string why;
-  if (!desk_->offerScale(event.getConstMessage()->data, why)) {
+  std::string why, note;
+  if (!desk_->offerScale(event.getConstMessage()->data, why, &note)) {
     refuseCommand("scale", sender, why);
     return;
   }
+  warnCommand("scale", sender, note);
   commandOffered();
 }
 

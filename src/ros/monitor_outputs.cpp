@@ -78,7 +78,7 @@ void MonitorNode::writeResult(const std::string& result, const std::string& reas
   f << "result: " << result << "\nscenario: " << scenario_.name << "\nsteps: " << scenario_.steps
     << "\ncompleted_step: " << completedStep() << "\nconverged_step: " << convergedStep_ << "\nformation: \""
     << formation.line << "\"\nfinal_max_distance_error: " << finalError_ << "\ndropped: " << dropped_ << "\ncommands: " << commandsIssued()
-    << "\ncommands_refused: " << commandsRefused_
+    << "\ncommands_refused: " << commandsRefused_ << "\ncommands_saturated: " << desk_->saturated()
     << "\nreason: \"" << quoted << "\"\n";
   if (!f) ROS_ERROR("monitor: cannot write the result file %s", resultFile_.c_str());
 }

@@ -11,6 +11,7 @@
 #include <random>
 
 #include "test_support.hpp"
+#include "variational_formation/core/error.hpp"
 #include "variational_formation/core/lockstep_agent.hpp"
 #include "variational_formation/core/manoeuvre_integrator.hpp"
 #include "variational_formation/core/protocol/command_desk.hpp"
@@ -123,6 +124,62 @@ TEST(CommandDesk, ARestartedMonitorGoesOnFromWhatWasIssued) {
   ASSERT_TRUE(after.offerScale(3.0, why));
   EXPECT_FALSE(after.issue(50));  // never at or before the last issued step
   EXPECT_TRUE(after.issue(51));
+}
+
+TEST(CommandDesk, SaturatesToTheLimitsAndWarnsAsAScenarioWould) {
+  // hexagon_manoeuvre: h = 0.01, kappa = 4; half the softest mode's frequency is 0.96 rad/s at
+  // s = 1 (doc/manoeuvres.md), and the stiffest mode is 10 rad/s.
+  protocol::CommandLimits limits;
+  limits.maxSpeed = 2.0;
+  limits.maxTurnRate = 1.0;
+  limits.minScale = 0.5;
+  limits.maxScale = 2.0;
+  CommandDesk desk(hexagon(100), limits);
+  std::string why, note;
+  ASSERT_TRUE(desk.offerVelocity({0.5, 0, 0}, {0, 0, 0.2}, why, &note)) << why;
+  EXPECT_EQ(note, "");
+  EXPECT_EQ(desk.saturated(), 0);
+  ASSERT_TRUE(desk.offerVelocity({1000, 0, 0}, {0, 0, 3}, why, &note)) << why;  // the issue's 1000 m/s
+  EXPECT_NE(note.find("|v*| = 1000 m/s saturated to ~max_speed = 2 m/s"), std::string::npos) << note;
+  EXPECT_NE(note.find("|omega*| = 3 rad/s saturated to ~max_turn_rate = 1 rad/s"), std::string::npos) << note;
+  EXPECT_NE(note.find("above half the softest shape mode's frequency"), std::string::npos) << note;
+  EXPECT_EQ(note.find('\n'), std::string::npos);
+  EXPECT_EQ(desk.saturated(), 1);
+  ASSERT_TRUE(desk.issue(5));
+  EXPECT_NEAR(desk.issued().back().second.velocity.x(), 2.0, 1e-12);
+  EXPECT_NEAR(desk.issued().back().second.angularRate.z(), 1.0, 1e-12);
+  // A turn of more than 0.1 rad per step is refused, not saturated.
+  EXPECT_FALSE(desk.offerVelocity({0, 0, 0}, {0, 0, 20}, why, &note));
+  EXPECT_NE(why.find("cmd_vel.angular_rate"), std::string::npos) << why;
+  ASSERT_TRUE(desk.offerScale(5.0, why, &note)) << why;
+  EXPECT_NE(note.find("s = 5 saturated to ~max_scale = 2"), std::string::npos) << note;
+  ASSERT_TRUE(desk.offerScale(0.1, why, &note)) << why;
+  EXPECT_NE(note.find("s = 0.1 saturated to ~min_scale = 0.5"), std::string::npos) << note;
+  // At s = 0.5 the rate of 1 rad/s issued above is more above half the softest frequency.
+  EXPECT_NE(note.find("rad/s at scale 0.5"), std::string::npos) << note;
+  EXPECT_EQ(desk.saturated(), 3);
+  ASSERT_TRUE(desk.issue(6));
+  EXPECT_EQ(desk.issued().back().second.scale, 0.5);
+}
+
+TEST(CommandDesk, RefusesAScaleBeyondTheStabilityLimitAndBadLimits) {
+  CommandDesk desk(hexagon(100));  // no limits: only stability refuses
+  std::string why;
+  EXPECT_TRUE(desk.offerScale(10.0, why)) << why;  // 100 rad/s: stable below about 0.02 s
+  EXPECT_FALSE(desk.offerScale(50.0, why));
+  EXPECT_EQ(why.rfind("scale: s = 50 puts h = 0.01 s above the linear stability limit", 0), 0u) << why;
+  protocol::CommandLimits bad;
+  bad.maxSpeed = 0.0;
+  EXPECT_THROW(CommandDesk(hexagon(100), bad), InvalidInput);
+  bad = protocol::CommandLimits();
+  bad.minScale = 2.0;
+  bad.maxScale = 1.0;
+  try {
+    protocol::validateCommandLimits(bad);
+    ADD_FAILURE() << "no exception";
+  } catch (const InvalidInput& e) {
+    EXPECT_EQ(std::string(e.what()), "~max_scale: must be >= ~min_scale = 2, got 1");
+  }
 }
 
 // The lockstep protocol with live commands, driven by one seed (see the file comment).

@@ -11,7 +11,8 @@ schedule. Then:
 - the bag's formation/command messages hold the issued commands, each written at the step it
   applies from;
 - without faults: bad commands (NaN, scale 0, a z velocity in 2D, and a good one from a node not
-  in ~commanders: a `rostopic pub` of its own) are dropped and counted, and the run goes on;
+  in ~commanders: a `rostopic pub` of its own) are dropped and counted, and the run goes on; a
+  command of 1000 m/s is kept at the monitor's ~max_speed (2 m/s) and counted as saturated;
 - with faults: an agent and then the monitor are killed (SIGKILL) during the manoeuvre, after
   some commands and before others; they respawn and the run stays exact.
 """
@@ -64,7 +65,7 @@ class ManoeuvreRun(unittest.TestCase, vf_rostest.RunChecks):
         assert velocity.get_num_connections() and scale.get_num_connections(), "the monitor never subscribed"
         # Commands at steps drawn over the first 70% of the run (wall time: step h / rate).
         at = sorted(rng.sample(range(50, int(0.7 * steps)), COMMANDS))
-        cls.sent, cls.bad_sent, cls.kills = [], 0, []
+        cls.sent, cls.bad_sent, cls.saturated_sent, cls.kills = [], 0, 0, []
         kill_agent_after, kill_monitor_after = 2, 4  # commands sent before each kill (faults)
         for n, step in enumerate(at):
             cls.wait_for_step(step, steps * h / rate + 60)
@@ -120,6 +121,11 @@ class ManoeuvreRun(unittest.TestCase, vf_rostest.RunChecks):
         subprocess.run(["rostopic", "pub", "-1", f"{NS}/cmd_vel", "geometry_msgs/Twist",
                         "{linear: {x: 0.1, y: 0.0, z: 0.0}}", "__name:=intruder"], capture_output=True, timeout=30)
         cls.bad_sent = 4
+        # Beyond the formation's ~max_speed (2 m/s): saturated, kept and counted.
+        fast = Twist()
+        fast.linear.x = 1000.0
+        velocity.publish(fast)
+        cls.saturated_sent = 1
 
     @classmethod
     def tearDownClass(cls):
@@ -129,8 +135,14 @@ class ManoeuvreRun(unittest.TestCase, vf_rostest.RunChecks):
         self.assertEqual(self.result.get("result"), "succeeded", f"result file: {self.result}")
         # Each input makes one command, unless two came before the allowed step moved (merged).
         self.assertGreaterEqual(int(self.result["commands"]), 2)
-        self.assertLessEqual(int(self.result["commands"]), COMMANDS)
+        self.assertLessEqual(int(self.result["commands"]), COMMANDS + self.saturated_sent)
         self.assertEqual(int(self.result["commands_refused"]), self.bad_sent, f"result file: {self.result}")
+        self.assertEqual(int(self.result["commands_saturated"]), self.saturated_sent, f"result file: {self.result}")
+        # No command beyond ~max_speed reached the agents: the 1000 m/s input ran at 2 m/s at most
+        # (a later velocity before the allowed step moved would replace it).
+        with open(self.commands_file) as f:
+            speeds = [math.hypot(float(r.split(",")[1]), float(r.split(",")[2])) for r in list(f)[1:]]
+        self.assertLessEqual(max(speeds), 2.0 + 1e-12, speeds)
 
     def test_bag_equals_simulate_on_the_commands_file(self):
         self.assertTrue(self.expected, f"no commands file {self.commands_file}")

@@ -90,6 +90,8 @@ class MonitorNode {
   void onScaleCommand(const ros::MessageEvent<std_msgs::Float64 const>& event);
   /// A command from a sender not in ~commanders is refused (empty: anyone may command).
   bool commanderAllowed(const std::string& sender, const char* topic);
+  /// A WARN line for an accepted command that was saturated or turns fast (`note` from the desk).
+  void warnCommand(const char* topic, const std::string& sender, const std::string& note) const;
   void refuseCommand(const char* topic, const std::string& sender, const std::string& why);
   /// Issues what is pending at `step`, keeps the list on the parameter server, publishes it;
   /// @return the number of issued commands, for the progress.

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -21,6 +22,22 @@ using IssuedCommand = std::pair<long, Command>;
 CommandSchedule appliedSchedule(const Scenario& scenario, const std::vector<IssuedCommand>& issued);
 
 /**
+ * The formation's limits on live commands (the monitor's ~max_speed, ~max_turn_rate, ~min_scale
+ * and ~max_scale; doc/manoeuvres.md): a command beyond one is saturated to it, not refused. None
+ * by default.
+ */
+struct CommandLimits {
+  double maxSpeed = std::numeric_limits<double>::infinity();     ///< |v*| [m/s] > 0
+  double maxTurnRate = std::numeric_limits<double>::infinity();  ///< |omega*| [rad/s] > 0
+  double minScale = 0.0;                                         ///< s >= 0
+  double maxScale = std::numeric_limits<double>::infinity();     ///< s >= minScale
+};
+
+/// maxSpeed, maxTurnRate > 0, 0 <= minScale <= maxScale, none NaN (infinity: no limit).
+/// @throws InvalidInput naming the monitor parameter.
+void validateCommandLimits(const CommandLimits& limits);
+
+/**
  * The monitor's side of live commands in a lockstep run (doc/protocol.md, "Commands"), without a
  * transport. Inputs are the two halves of a command: a velocity (cmd_vel: v*, omega*) and a scale
  * (s); each is checked (validateCommand, and whether the formation can turn) and, if good, makes
@@ -32,16 +49,28 @@ CommandSchedule appliedSchedule(const Scenario& scenario, const std::vector<Issu
  * input before A moves stays pending and is issued, merged, at the next A. The monitor publishes
  * the list before any progress that allows a step beyond A, and that progress counts the list;
  * an agent steps only while it holds that many commands.
+ *
+ * Checks, in order: refused as a scenario's manoeuvre would be (validateCommand: NaN, a 3D part
+ * in 2D, a turn of more than 0.1 rad per step), or a turn the formation cannot make, or a scale
+ * whose shape breaks the linear stability limit of h; then saturated to the limits (counted);
+ * then, like a scenario's manoeuvre, a note if |omega*| is above half the softest shape mode's
+ * frequency at the scale it will run at.
  */
 class CommandDesk {
  public:
-  /// @param scenario validated (its dimension, h, manoeuvre and formation).
-  explicit CommandDesk(const Scenario& scenario);
+  /// @param scenario validated (its dimension, h, manoeuvre and formation); @param limits validated.
+  explicit CommandDesk(const Scenario& scenario, const CommandLimits& limits = CommandLimits());
 
-  /// A velocity command (v*, omega*). @return false with `why` (one line) if it is refused.
-  bool offerVelocity(const Vector3& velocity, const Vector3& angularRate, std::string& why);
-  /// A scale command (s). @return false with `why` if it is refused.
-  bool offerScale(double scale, std::string& why);
+  /**
+   * A velocity command (v*, omega*). @return false with `why` (one line) if it is refused.
+   * @param note if given: "" or one line on what was saturated and what to expect (a WARN).
+   */
+  bool offerVelocity(const Vector3& velocity, const Vector3& angularRate, std::string& why,
+                     std::string* note = nullptr);
+  /// A scale command (s). @return false with `why` if it is refused; `note` as offerVelocity.
+  bool offerScale(double scale, std::string& why, std::string* note = nullptr);
+  /// Commands saturated to the limits so far.
+  long saturated() const { return saturated_; }
 
   /// A command waits to be issued.
   bool pending() const { return pendingVelocity_ || pendingScale_; }
@@ -69,8 +98,13 @@ class CommandDesk {
   /// validateCommand (fields named `field`.velocity, ...) and, if it turns, whether the formation
   /// can; false with `why` otherwise.
   bool acceptable(const Command& command, const std::string& field, std::string& why) const;
+  /// The note on |omega*| against half the softest mode's frequency at scale s ("" if below).
+  std::string turnNote(const Vector3& angularRate, double scale) const;
 
   Scenario scenario_;
+  CommandLimits limits_;
+  double softest_ = 0.0, stiffest_ = 0.0;  // shape modes' frequencies at s = 1 [rad/s]
+  long saturated_ = 0;
   bool canTurn_ = true;
   std::string whyNoTurn_;
   bool pendingVelocity_ = false, pendingScale_ = false;
