@@ -196,7 +196,7 @@ def first_instant(contents, topics, first):
 class Scene:
     """Where the replayed span happens, for the camera: the parent frame of the recorded transforms
     (rviz's fixed frame), the box around every transform's origin in it, and the radius of the
-    agents' spheres (the package's markers scale with the formation: DESIGN.md, markers)."""
+    agents' spheres (the monitor's markers scale with the formation: doc/render.md, step 1)."""
 
     def __init__(self, contents, markers, first, last):
         import rosbag
