@@ -36,6 +36,7 @@ TOOLS = {"ffmpeg": "ffmpeg", "ffprobe": "ffmpeg", "Xvfb": "xvfb", "rviz": "rviz"
          "rosmaster": "python3-rosmaster"}  # each with its Debian package
 MARKERS = "/formation/markers"  # the topic config/formation.rviz shows, below a team's namespace
 TF_SCALE = 8.0  # tf axes and names: this many sphere radii
+AGENT_FRAME = re.compile(r"(^|/)formation/agent_\d+$")  # an agent's tf frame, below any team namespace
 FIT_DISTANCE = 3.0  # camera distance over the formation's reach (half the box's diagonal)
 WARM_UP = 1.0  # seconds rviz gets to draw the first instant before the replay goes on
 LATENCY_MAX = 1.0  # seconds rviz may take to draw what it receives
@@ -61,9 +62,9 @@ def parse_args():
     parser.add_argument("--size", default="1100x800", help="video size WxH in pixels (default 1100x800)")
     parser.add_argument("--fps", type=int, default=25, help="frames per second, 1..60 (default 25)")
     parser.add_argument("--from", dest="start", type=float, default=0.0,
-                        help="seconds of the run (bag time from its start: simulated time) to start at")
+                        help="seconds of the run's own time (t = k h of the status, from its first step) to start at")
     parser.add_argument("--to", dest="end", type=float, default=None,
-                        help="seconds of the run to end at (default: the end of the bag)")
+                        help="seconds of the run's own time to end at (default: its last step in the bag)")
     parser.add_argument("--ns", default=None,
                         help="the team's namespace (topics /NS/formation/...); default: the bag's only team")
     parser.add_argument("--camera", choices=("fit", "config"), default="fit",
@@ -176,6 +177,49 @@ def choose_topics(contents, ns):
     return prefix, markers, odometry, replay
 
 
+class RunSpan:
+    """The part of the run to show, in the run's own time and in bag time.
+
+    The run's time is the status's `time` (t_k = k h from the run's first step), which the
+    status text shows. A lockstep bag's time is that simulated time. A timed or robots bag's time
+    is the wall time rosbag record received each message: it starts when the recorder does, while
+    the robots already publish and the agents still wait for the start, and it ends when the
+    launch stops it, after the run. So the span runs from the markers of the first shown step to
+    those of the last (stamped like that step's status; the status itself where a step has no
+    markers). A bag without status is shown whole, from its start."""
+
+    def __init__(self, contents, status, markers, start, end):
+        import rosbag
+        self.start, self.end = start, end  # run time [s]
+        if status not in contents.topics:
+            length = contents.end - contents.start
+            if start >= length:
+                fail(f"--from {start}: the bag lasts only {length:.3f} s")
+            self.end = length if end is None else min(end, length)
+            self.first, self.last = contents.start + start, contents.start + self.end  # bag time [s]
+            return
+        steps = []  # (t_k, header stamp) of each status, in bag order
+        received = {status: {}, markers: {}}  # topic: {header stamp: bag times}
+        for path in contents.parts:
+            with rosbag.Bag(path) as bag:
+                for topic, msg, t in bag.read_messages(topics=[status] + ([markers] if markers else [])):
+                    if topic == status:
+                        stamp = msg.header.stamp.to_nsec()
+                        steps.append((msg.time, stamp))
+                    elif msg.markers:
+                        stamp = msg.markers[0].header.stamp.to_nsec()
+                    else:
+                        continue
+                    received[topic].setdefault(stamp, []).append(t.to_sec())
+        shown = [(time, stamp) for time, stamp in steps if time >= start and (end is None or time <= end)]
+        if not shown:
+            fail(f"--from {start}: the run's status in the bag covers {steps[0][0]:.3f} to {steps[-1][0]:.3f} s"
+                 if steps else f"{status}: no status message in the bag")
+        (self.start, first), (self.end, last) = shown[0], shown[-1]
+        self.first = min(received[markers].get(first) or received[status][first])
+        self.last = max(received[markers].get(last) or received[status][last])
+
+
 def first_instant(contents, topics, first):
     """How many of the replayed messages share the earliest bag time from `first` on, and the bag
     time that follows it (None if there is none)."""
@@ -202,12 +246,14 @@ class Scene:
         import rosbag
         import rospy
         self.fixed_frame, self.radius = None, None
+        self.frames = set()  # every child frame of the recorded transforms
         self.low, self.high = [float("inf")] * 3, [float("-inf")] * 3
         window = {"start_time": rospy.Time.from_sec(first), "end_time": rospy.Time.from_sec(last)}
         for path in contents.parts:
             with rosbag.Bag(path) as bag:
                 for _, msg, _ in bag.read_messages(topics=["/tf"], **window):
                     for t in msg.transforms:
+                        self.frames.add(t.child_frame_id.lstrip("/"))
                         self.fixed_frame = self.fixed_frame or t.header.frame_id.lstrip("/")
                         if t.header.frame_id.lstrip("/") == self.fixed_frame:
                             p = t.transform.translation
@@ -231,13 +277,22 @@ def rviz_config(template, markers, odometry, scene, args):
     with open(template) as f:
         config = yaml.safe_load(f)
     manager = config["Visualization Manager"]
-    for display in manager["Displays"]:
+    agents = {f for f in scene.frames if AGENT_FRAME.search(f)}
+    others = scene.frames - agents - {scene.fixed_frame}
+    for display in list(manager["Displays"]):
         if display.get("Class") == "rviz/MarkerArray" and markers:
             display["Marker Topic"] = markers
         if display.get("Class") == "rviz/TF" and scene.radius:
             # Axes and names that stick out of the agents' spheres: the spheres' radius is a tenth
             # of the shortest desired distance.
             display["Marker Scale"] = round(TF_SCALE * scene.radius, 3)
+        if display.get("Class") == "rviz/TF" and agents and others:
+            # A robot's base_link sits on (or a hand offset from) its agent's frame, and the two
+            # names would be drawn on top of each other: one name per robot, the agent's; the
+            # robots' frames keep their axes, in a second display without names.
+            display["Frames"] = {"All Enabled": True, **{f: {"Value": False} for f in sorted(others)}}
+            manager["Displays"].append(dict(display, Name="Robot frames", **{"Show Names": False}, Frames={
+                "All Enabled": True, **{f: {"Value": False} for f in sorted(agents | {scene.fixed_frame})}}))
     for k, topic in enumerate(odometry):
         manager["Displays"].append({
             "Class": "rviz/Odometry", "Enabled": True, "Name": topic, "Topic": topic, "Keep": 1,
@@ -422,11 +477,12 @@ def start_capture(procs, display, width, height, fps, path):
     return capture
 
 
-def start_player(procs, args, first, span, topics, env, rviz):
-    """rosbag play of `span` seconds of the bag from bag time `first`, paused at its first message
-    once rviz has connected to every topic it plays."""
-    cmd = ["rosbag", "play", "--clock", "--pause", "--rate", repr(args.speed), "--start", repr(args.start),
-           "--duration", repr(span), "--wait-for-subscribers", "--delay", "0.5"] + args.bags + ["--topics"] + topics
+def start_player(procs, args, start, first, span, topics, env, rviz):
+    """rosbag play of `span` seconds of the bag (which starts at bag time `start`) from bag time
+    `first`, paused at its first message once rviz has connected to every topic it plays."""
+    # A microsecond either side: the bag times go through floating point and back.
+    cmd = ["rosbag", "play", "--clock", "--pause", "--rate", repr(args.speed), "--start",
+           repr(max(0.0, first - start - 1e-6)), "--duration", repr(span + 2e-6), "--wait-for-subscribers", "--delay", "0.5"] + args.bags + ["--topics"] + topics
     player = procs.start("play", cmd, env=env, stdout=subprocess.PIPE, stdin=subprocess.PIPE)
     read_until(procs, player, rviz, b"[PAUSED", STARTUP_TIMEOUT)
     return player
@@ -556,12 +612,9 @@ def package_path():
 
 def render(args, procs, tmp, progress):
     contents = BagContents(args.bags)
-    length = contents.end - contents.start
-    if args.start >= length:
-        fail(f"--from {args.start}: the bag lasts only {length:.3f} s")
-    span = (length if args.end is None else min(args.end, length)) - args.start
-    _, markers, odometry, topics = choose_topics(contents, args.ns)
-    first = contents.start + args.start
+    prefix, markers, odometry, topics = choose_topics(contents, args.ns)
+    run = RunSpan(contents, prefix + "/formation/status", markers, args.start, args.end)
+    first, span = run.first, run.last - run.first
     scene = Scene(contents, markers, first, first + span)
     config = os.path.join(tmp, "formation.rviz")
     with open(config, "w") as f:
@@ -574,7 +627,7 @@ def render(args, procs, tmp, progress):
     env["DISPLAY"] = display
     rviz = procs.start("rviz", ["rviz", "-d", config, "--fullscreen", "__name:=render_rviz"], env=env)
     wait_for_rviz(procs, rviz, master, [t for t in topics if t != "/tf_static"])
-    player = start_player(procs, args, first, span, topics, env, rviz)
+    player = start_player(procs, args, contents.start, first, span, topics, env, rviz)
     timings = {"start-up": time.time()}
     capture_path = os.path.join(tmp, "capture.mkv")
     capture = start_capture(procs, display, args.width, args.height, args.fps, capture_path)
@@ -601,7 +654,7 @@ def render(args, procs, tmp, progress):
     offset = started + latency - start_time - 0.5 / args.fps
     encode(capture_path, max(0.0, offset), played, args.out, args.fps)
     timings["encoding"] = time.time()
-    return args.start, args.start + span, played, timings
+    return run.start, run.end, played, timings
 
 
 def main():

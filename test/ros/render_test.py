@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """rostest (render.test): render_bag.py turns the hexagon's bag, recorded by formation.launch in
 the same launch and split in parts (hexagon.bag, hexagon_1.bag, ...), into an MP4 and a GIF.
+With the argument `robots` (render.test kind:=robots), the bag of robots.launch instead.
 
 Checks, on both videos: ffprobe's duration is the run's (4.2 s) over the speed, within 10%, at
 the asked size; no frame is blank; the last frame shows every agent's colour; the first and last
@@ -8,6 +9,11 @@ frames differ. A namespaced team's bag renders with --ns. No process the render 
 it, after a good run, after Ctrl-C, or after a failure. Bad inputs get one line on stderr and a
 non-zero status: no bag, an empty bag, no ffmpeg on PATH, a display that cannot start (taken by
 another X server), rviz that dies.
+
+robots.launch's bag is on wall time and holds the robots' messages from before the run's first
+step to after its last (here 1 s after it, as a launch ending at the run's end would): its
+video is the run, 4.2 s over the speed, within a frame and a status tick, and not the bag's
+length; the first frame shows every agent (the markers of step 0), as does the last.
 
 VF_TEST_DISPLAY=:N (optional) makes every render use X display :N, and the busy-display case
 N + 1; by default Xvfb picks free ones.
@@ -36,6 +42,7 @@ import vf_rostest  # noqa: E402
 
 PKG = vf_rostest.PKG
 RUN_SECONDS = 4.2  # config/hexagon.yaml: 300 steps of 0.014 s
+AFTER_THE_RUN = 1.0  # [s] robots: the recording goes on this long after the run
 SPEED, FPS, WIDTH, HEIGHT = 2.0, 20, 640, 480
 # Standard deviation of the pixel values (0..255) of a frame: measured 12.5 for rviz's empty grid
 # at this size, 21 to 23 with the hexagon drawn.
@@ -120,10 +127,11 @@ class Watched:
         return left
 
 
-@vf_rostest.reported_setup
-class RenderTest(unittest.TestCase):
+class RecordedHexagon(unittest.TestCase):
+    """The hexagon's run that the launch records (its result, its bag), and a folder for videos."""
+
     @classmethod
-    def setUpClass(cls):
+    def wait_for_the_run(cls):
         rospy.init_node("render_test")
         cls.out = rospy.get_param("~output_dir")
         cls.result = vf_rostest.wait_for_result(os.path.join(cls.out, "hexagon.result.yaml"), 120.0)
@@ -131,9 +139,23 @@ class RenderTest(unittest.TestCase):
         cls.tmp = tempfile.mkdtemp(prefix="render_test_")
 
     @classmethod
-    def tearDownClass(cls):
+    def remove_files(cls):
         shutil.rmtree(cls.out, ignore_errors=True)
         shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def setUp(self):
+        self.assertEqual(self.result.get("result"), "succeeded", f"the recorded run: {self.result}")
+
+
+@vf_rostest.reported_setup
+class RenderTest(RecordedHexagon):
+    @classmethod
+    def setUpClass(cls):
+        cls.wait_for_the_run()
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.remove_files()
 
     def render(self, *args, env=None):
         display = test_display()
@@ -150,9 +172,6 @@ class RenderTest(unittest.TestCase):
         self.assertEqual(len(err.strip().splitlines()), 1, f"one line on stderr, got: {err}")
         for word in words:
             self.assertIn(word, err)
-
-    def setUp(self):
-        self.assertEqual(self.result.get("result"), "succeeded", f"the recorded run: {self.result}")
 
     def test_videos_of_the_run(self):
         self.assertTrue(os.path.exists(self.bag[:-len(".bag")] + "_1.bag"), "the recording is not split")
@@ -274,5 +293,47 @@ class RenderTest(unittest.TestCase):
         self.assert_nothing_left(watched)
 
 
+@vf_rostest.reported_setup
+class RenderRobotsTest(RecordedHexagon):
+    @classmethod
+    def setUpClass(cls):
+        cls.wait_for_the_run()
+        # The recording goes on after the run until the launch ends; then a clean stop closes the bag.
+        time.sleep(AFTER_THE_RUN)
+        subprocess.run(["rosnode", "kill", "/formation/recorder"], capture_output=True)
+        end = time.time() + 15
+        while not os.path.exists(cls.bag) and time.time() < end:
+            time.sleep(0.2)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.remove_files()
+
+    def test_the_video_is_the_run(self):
+        import rosbag
+        with rosbag.Bag(self.bag) as bag:
+            length = bag.get_end_time() - bag.get_start_time()
+        # What makes the check below tell the run from the bag.
+        self.assertGreater(length, RUN_SECONDS + AFTER_THE_RUN, "the bag holds no time around the run")
+        video = os.path.join(self.tmp, "robots.mp4")
+        display = test_display()
+        watched = Watched([self.bag, "--out", video, "--speed", str(SPEED), "--fps", str(FPS), "--size",
+                           f"{WIDTH}x{HEIGHT}"] + (["--display", display] if display else []))
+        code, out, err = watched.finish()
+        self.assertEqual(code, 0, err)
+        self.assertIn(f"0.00..{RUN_SECONDS:.2f} s of the run", out)
+        probe = subprocess.run(["ffprobe", "-v", "error", "-show_entries", "format=duration", "-of",
+                                "default=noprint_wrappers=1:nokey=1", video], capture_output=True, text=True, check=True)
+        # The monitor's ticks: within one of the run's steps at each end, and a frame.
+        self.assertAlmostEqual(float(probe.stdout), RUN_SECONDS / SPEED, delta=(2 * 0.014 + 1.0 / FPS) / SPEED + 0.05,
+                               msg=f"the video's length; the bag lasts {length:.2f} s")
+        raw = subprocess.run(["ffmpeg", "-v", "error", "-i", video, "-f", "rawvideo", "-pix_fmt", "rgb24", "-"],
+                             capture_output=True, check=True).stdout
+        frames = np.frombuffer(raw, dtype=np.uint8).reshape(-1, HEIGHT, WIDTH, 3)
+        for name, frame in (("first", frames[0]), ("last", frames[-1])):
+            for rgb, count in zip(vf_rostest.PALETTE, vf_rostest.agent_colour_pixels(frame / 255.0)):
+                self.assertGreater(count, 30, f"an agent's colour {rgb} is not in the {name} frame")
+
+
 if __name__ == "__main__":
-    rostest.rosrun(PKG, "render_test", RenderTest, sys.argv)
+    rostest.rosrun(PKG, "render_test", RenderRobotsTest if "robots" in sys.argv[1:] else RenderTest, sys.argv)
