@@ -30,6 +30,7 @@ import yaml
 # The package is importable once devel/setup.bash is sourced; this also finds it in a checkout.
 sys.path.append(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "src"))
 from variational_formation.cli import fail  # noqa: E402
+from variational_formation.run_clock import RunSpan  # noqa: E402
 
 FORMATS = (".mp4", ".gif")
 TOOLS = {"ffmpeg": "ffmpeg", "ffprobe": "ffmpeg", "Xvfb": "xvfb", "rviz": "rviz", "rosbag": "python3-rosbag",
@@ -175,49 +176,6 @@ def choose_topics(contents, ns):
         fail(f"nothing in the bag that rviz shows: no {prefix}{MARKERS}, /tf or robot odometry "
              f"(topics: {', '.join(sorted(contents.topics))})")
     return prefix, markers, odometry, replay
-
-
-class RunSpan:
-    """The part of the run to show, in the run's own time and in bag time.
-
-    The run's time is the status's `time` (t_k = k h from the run's first step), which the
-    status text shows. A lockstep bag's time is that simulated time. A timed or robots bag's time
-    is the wall time rosbag record received each message: it starts when the recorder does, while
-    the robots already publish and the agents still wait for the start, and it ends when the
-    launch stops it, after the run. So the span runs from the markers of the first shown step to
-    those of the last (stamped like that step's status; the status itself where a step has no
-    markers). A bag without status is shown whole, from its start."""
-
-    def __init__(self, contents, status, markers, start, end):
-        import rosbag
-        self.start, self.end = start, end  # run time [s]
-        if status not in contents.topics:
-            length = contents.end - contents.start
-            if start >= length:
-                fail(f"--from {start}: the bag lasts only {length:.3f} s")
-            self.end = length if end is None else min(end, length)
-            self.first, self.last = contents.start + start, contents.start + self.end  # bag time [s]
-            return
-        steps = []  # (t_k, header stamp) of each status, in bag order
-        received = {status: {}, markers: {}}  # topic: {header stamp: bag times}
-        for path in contents.parts:
-            with rosbag.Bag(path) as bag:
-                for topic, msg, t in bag.read_messages(topics=[status] + ([markers] if markers else [])):
-                    if topic == status:
-                        stamp = msg.header.stamp.to_nsec()
-                        steps.append((msg.time, stamp))
-                    elif msg.markers:
-                        stamp = msg.markers[0].header.stamp.to_nsec()
-                    else:
-                        continue
-                    received[topic].setdefault(stamp, []).append(t.to_sec())
-        shown = [(time, stamp) for time, stamp in steps if time >= start and (end is None or time <= end)]
-        if not shown:
-            fail(f"--from {start}: the run's status in the bag covers {steps[0][0]:.3f} to {steps[-1][0]:.3f} s"
-                 if steps else f"{status}: no status message in the bag")
-        (self.start, first), (self.end, last) = shown[0], shown[-1]
-        self.first = min(received[markers].get(first) or received[status][first])
-        self.last = max(received[markers].get(last) or received[status][last])
 
 
 def first_instant(contents, topics, first):
@@ -477,12 +435,12 @@ def start_capture(procs, display, width, height, fps, path):
     return capture
 
 
-def start_player(procs, args, start, first, span, topics, env, rviz):
-    """rosbag play of `span` seconds of the bag (which starts at bag time `start`) from bag time
-    `first`, paused at its first message once rviz has connected to every topic it plays."""
-    # A microsecond either side: the bag times go through floating point and back.
+def start_player(procs, args, contents, first, span, topics, env, rviz):
+    """rosbag play of `span` seconds of the bag from bag time `first`, paused at its first message
+    once rviz has connected to every topic it plays."""
     cmd = ["rosbag", "play", "--clock", "--pause", "--rate", repr(args.speed), "--start",
-           repr(max(0.0, first - start - 1e-6)), "--duration", repr(span + 2e-6), "--wait-for-subscribers", "--delay", "0.5"] + args.bags + ["--topics"] + topics
+           repr(max(0.0, first - contents.start)), "--duration", repr(span), "--wait-for-subscribers", "--delay",
+           "0.5"] + contents.parts + ["--topics"] + topics
     player = procs.start("play", cmd, env=env, stdout=subprocess.PIPE, stdin=subprocess.PIPE)
     read_until(procs, player, rviz, b"[PAUSED", STARTUP_TIMEOUT)
     return player
@@ -614,6 +572,11 @@ def render(args, procs, tmp, progress):
     contents = BagContents(args.bags)
     prefix, markers, odometry, topics = choose_topics(contents, args.ns)
     run = RunSpan(contents, prefix + "/formation/status", markers, args.start, args.end)
+    if run.on_wall_time:
+        # A timed or robots bag: replay a copy on the run's clock (variational_formation/run_clock.py).
+        copy = os.path.join(tmp, "run.bag")
+        run.write_on_run_time(contents, topics, copy)
+        contents = BagContents([copy])
     first, span = run.first, run.last - run.first
     scene = Scene(contents, markers, first, first + span)
     config = os.path.join(tmp, "formation.rviz")
@@ -627,7 +590,7 @@ def render(args, procs, tmp, progress):
     env["DISPLAY"] = display
     rviz = procs.start("rviz", ["rviz", "-d", config, "--fullscreen", "__name:=render_rviz"], env=env)
     wait_for_rviz(procs, rviz, master, [t for t in topics if t != "/tf_static"])
-    player = start_player(procs, args, contents.start, first, span, topics, env, rviz)
+    player = start_player(procs, args, contents, first, span, topics, env, rviz)
     timings = {"start-up": time.time()}
     capture_path = os.path.join(tmp, "capture.mkv")
     capture = start_capture(procs, display, args.width, args.height, args.fps, capture_path)

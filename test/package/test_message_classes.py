@@ -12,15 +12,14 @@ headers alone do not bring. The types are found in the code, not listed by hand:
 import glob
 import os
 import re
-import sys
 import unittest
 
 import rospkg
 from roslib.message import get_message_class, get_service_class
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-from vf_harness import REPO  # noqa: E402
-
+# Not through vf_harness, which puts src/ first on sys.path: its variational_formation has no
+# msg module, and would hide the built one that rostopic finds.
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
 PKG = "variational_formation"
 # A library header the nodes include, and the types that library publishes or serves for them.
 LIBRARY_TYPES = {

@@ -10,10 +10,11 @@ it, after a good run, after Ctrl-C, or after a failure. Bad inputs get one line 
 non-zero status: no bag, an empty bag, no ffmpeg on PATH, a display that cannot start (taken by
 another X server), rviz that dies.
 
-robots.launch's bag is on wall time and holds the robots' messages from before the run's first
-step to after its last (here 1 s after it, as a launch ending at the run's end would): its
-video is the run, 4.2 s over the speed, within a frame and a status tick, and not the bag's
-length; the first frame shows every agent (the markers of step 0), as does the last.
+robots.launch's bag is on wall time and holds the robots' messages until after the run's last
+step (here 1 s after it, as a launch ending at the run's end would), and from before its first
+step or from the step at which rosbag record joined: its video is the run from the first
+recorded step (within two steps) to the last, (4.2 s - that step's t) over the speed within 1.5
+frames, not the bag's length; 90 % of the frames and the last one show every agent.
 
 VF_TEST_DISPLAY=:N (optional) makes every render use X display :N, and the busy-display case
 N + 1; by default Xvfb picks free ones.
@@ -22,6 +23,7 @@ Private parameters:
   output_dir   where formation.launch writes the bag and the result file (removed after)
 """
 import os
+import re
 import select
 import shutil
 import signal
@@ -41,7 +43,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import vf_rostest  # noqa: E402
 
 PKG = vf_rostest.PKG
-RUN_SECONDS = 4.2  # config/hexagon.yaml: 300 steps of 0.014 s
+RUN_SECONDS, STEP = 4.2, 0.014  # config/hexagon.yaml: 300 steps of 0.014 s
 AFTER_THE_RUN = 1.0  # [s] robots: the recording goes on this long after the run
 SPEED, FPS, WIDTH, HEIGHT = 2.0, 20, 640, 480
 # Standard deviation of the pixel values (0..255) of a frame: measured 12.5 for rviz's empty grid
@@ -313,26 +315,34 @@ class RenderRobotsTest(RecordedHexagon):
         import rosbag
         with rosbag.Bag(self.bag) as bag:
             length = bag.get_end_time() - bag.get_start_time()
+            # rosbag record may join some steps into the run (the timed monitor does not wait for it).
+            joined = next(bag.read_messages(topics=["/formation/status"]))[1].time
         # What makes the check below tell the run from the bag.
-        self.assertGreater(length, RUN_SECONDS + AFTER_THE_RUN, "the bag holds no time around the run")
+        self.assertGreater(length, RUN_SECONDS - joined + AFTER_THE_RUN, "the bag holds no time around the run")
         video = os.path.join(self.tmp, "robots.mp4")
         display = test_display()
         watched = Watched([self.bag, "--out", video, "--speed", str(SPEED), "--fps", str(FPS), "--size",
                            f"{WIDTH}x{HEIGHT}"] + (["--display", display] if display else []))
         code, out, err = watched.finish()
         self.assertEqual(code, 0, err)
-        self.assertIn(f"0.00..{RUN_SECONDS:.2f} s of the run", out)
+        # The run from its first recorded step (or the next, whose markers the bag holds) to its end.
+        shown = re.search(r"([0-9.]+)\.\.([0-9.]+) s of the run", out)
+        self.assertTrue(shown, out)
+        self.assertAlmostEqual(float(shown[1]), joined, delta=2 * STEP + 0.005, msg=out)
+        self.assertEqual(shown[2], f"{RUN_SECONDS:.2f}", out)
         probe = subprocess.run(["ffprobe", "-v", "error", "-show_entries", "format=duration", "-of",
                                 "default=noprint_wrappers=1:nokey=1", video], capture_output=True, text=True, check=True)
         # The monitor's ticks: within one of the run's steps at each end, and a frame.
-        self.assertAlmostEqual(float(probe.stdout), RUN_SECONDS / SPEED, delta=(2 * 0.014 + 1.0 / FPS) / SPEED + 0.05,
+        self.assertAlmostEqual(float(probe.stdout), (RUN_SECONDS - float(shown[1])) / SPEED, delta=1.5 / FPS,
                                msg=f"the video's length; the bag lasts {length:.2f} s")
         raw = subprocess.run(["ffmpeg", "-v", "error", "-i", video, "-f", "rawvideo", "-pix_fmt", "rgb24", "-"],
                              capture_output=True, check=True).stdout
         frames = np.frombuffer(raw, dtype=np.uint8).reshape(-1, HEIGHT, WIDTH, 3)
-        for name, frame in (("first", frames[0]), ("last", frames[-1])):
-            for rgb, count in zip(vf_rostest.PALETTE, vf_rostest.agent_colour_pixels(frame / 255.0)):
-                self.assertGreater(count, 30, f"an agent's colour {rgb} is not in the {name} frame")
+        # The markers of the run throughout: rviz may draw the first picture's markers a frame late.
+        without = [k for k, frame in enumerate(frames)
+                   if min(vf_rostest.agent_colour_pixels(frame / 255.0)) <= 30]
+        self.assertLessEqual(len(without), 0.1 * len(frames), f"frames without every agent's colour: {without}")
+        self.assertNotIn(len(frames) - 1, without, "the last frame lacks an agent")
 
 
 if __name__ == "__main__":
