@@ -5,7 +5,9 @@ if(CATKIN_ENABLE_TESTING)
   set(VF_PYTHON_TEST_GROUPS
     "python_helpers:test/python/test_helpers.py"
     "python_scripts:test/python/test_scripts.py"
+    "python_render_inputs:test/python/test_render_inputs.py"
     "package_dependencies:test/package/test_dependencies.py"
+    "package_message_classes:test/package/test_message_classes.py"
     "package_catkin_lint:test/package/test_catkin_lint.py"
     "package_launch_files:test/package/test_launch_files.py"
     "package_install:test/package/test_install.py")

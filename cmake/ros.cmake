@@ -89,8 +89,10 @@ if(CATKIN_ENABLE_TESTING)
     "case:=ring7_lag03 scenario:=ring7 lag:=0.3 time_limit:=90 expect_lag_warning:=true"
     "case:=ring7_unicycle_lag01 scenario:=ring7 lag:=0.1 kinematics:=unicycle heading_seed:=3 time_limit:=90 expect_lag_warning:=true"
     "case:=ring7_unicycle_lag03 scenario:=ring7 lag:=0.3 kinematics:=unicycle heading_seed:=5 time_limit:=90 expect_lag_warning:=true")
-  # render_bag.py on a recorded hexagon: video length, frames, processes left, bad inputs.
-  add_rostest(test/ros/render.test)
+  # render_bag.py on a recorded hexagon: video length, frames, processes left, bad inputs; and on
+  # robots.launch's wall-time bag: the video is the run from its first step, one name per robot.
+  add_rostest(test/ros/render.test ARGS kind:=formation)
+  add_rostest(test/ros/render.test ARGS kind:=robots)
   # SIGKILL to the nodelet manager of every agent during a recorded run: test/ros/nodelet_fault.test.
   add_rostest(test/ros/nodelet_fault.test ARGS seed:=3)
   # live_tf: tf lookups at now() during a default run (/clock, /use_sim_time).

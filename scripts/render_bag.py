@@ -30,12 +30,14 @@ import yaml
 # The package is importable once devel/setup.bash is sourced; this also finds it in a checkout.
 sys.path.append(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "src"))
 from variational_formation.cli import fail  # noqa: E402
+from variational_formation.run_clock import RunSpan  # noqa: E402
 
 FORMATS = (".mp4", ".gif")
 TOOLS = {"ffmpeg": "ffmpeg", "ffprobe": "ffmpeg", "Xvfb": "xvfb", "rviz": "rviz", "rosbag": "python3-rosbag",
          "rosmaster": "python3-rosmaster"}  # each with its Debian package
 MARKERS = "/formation/markers"  # the topic config/formation.rviz shows, below a team's namespace
 TF_SCALE = 8.0  # tf axes and names: this many sphere radii
+AGENT_FRAME = re.compile(r"(^|/)formation/agent_\d+$")  # an agent's tf frame, below any team namespace
 FIT_DISTANCE = 3.0  # camera distance over the formation's reach (half the box's diagonal)
 WARM_UP = 1.0  # seconds rviz gets to draw the first instant before the replay goes on
 LATENCY_MAX = 1.0  # seconds rviz may take to draw what it receives
@@ -61,9 +63,9 @@ def parse_args():
     parser.add_argument("--size", default="1100x800", help="video size WxH in pixels (default 1100x800)")
     parser.add_argument("--fps", type=int, default=25, help="frames per second, 1..60 (default 25)")
     parser.add_argument("--from", dest="start", type=float, default=0.0,
-                        help="seconds of the run (bag time from its start: simulated time) to start at")
+                        help="seconds of the run's own time (t = k h of the status, from its first step) to start at")
     parser.add_argument("--to", dest="end", type=float, default=None,
-                        help="seconds of the run to end at (default: the end of the bag)")
+                        help="seconds of the run's own time to end at (default: its last step in the bag)")
     parser.add_argument("--ns", default=None,
                         help="the team's namespace (topics /NS/formation/...); default: the bag's only team")
     parser.add_argument("--camera", choices=("fit", "config"), default="fit",
@@ -196,18 +198,20 @@ def first_instant(contents, topics, first):
 class Scene:
     """Where the replayed span happens, for the camera: the parent frame of the recorded transforms
     (rviz's fixed frame), the box around every transform's origin in it, and the radius of the
-    agents' spheres (the package's markers scale with the formation: DESIGN.md, markers)."""
+    agents' spheres (the monitor's markers scale with the formation: doc/render.md, step 1)."""
 
     def __init__(self, contents, markers, first, last):
         import rosbag
         import rospy
         self.fixed_frame, self.radius = None, None
+        self.frames = set()  # every child frame of the recorded transforms
         self.low, self.high = [float("inf")] * 3, [float("-inf")] * 3
         window = {"start_time": rospy.Time.from_sec(first), "end_time": rospy.Time.from_sec(last)}
         for path in contents.parts:
             with rosbag.Bag(path) as bag:
                 for _, msg, _ in bag.read_messages(topics=["/tf"], **window):
                     for t in msg.transforms:
+                        self.frames.add(t.child_frame_id.lstrip("/"))
                         self.fixed_frame = self.fixed_frame or t.header.frame_id.lstrip("/")
                         if t.header.frame_id.lstrip("/") == self.fixed_frame:
                             p = t.transform.translation
@@ -231,13 +235,22 @@ def rviz_config(template, markers, odometry, scene, args):
     with open(template) as f:
         config = yaml.safe_load(f)
     manager = config["Visualization Manager"]
-    for display in manager["Displays"]:
+    agents = {f for f in scene.frames if AGENT_FRAME.search(f)}
+    others = scene.frames - agents - {scene.fixed_frame}
+    for display in list(manager["Displays"]):
         if display.get("Class") == "rviz/MarkerArray" and markers:
             display["Marker Topic"] = markers
         if display.get("Class") == "rviz/TF" and scene.radius:
             # Axes and names that stick out of the agents' spheres: the spheres' radius is a tenth
             # of the shortest desired distance.
             display["Marker Scale"] = round(TF_SCALE * scene.radius, 3)
+        if display.get("Class") == "rviz/TF" and agents and others:
+            # A robot's base_link sits on (or a hand offset from) its agent's frame, and the two
+            # names would be drawn on top of each other: one name per robot, the agent's; the
+            # robots' frames keep their axes, in a second display without names.
+            display["Frames"] = {"All Enabled": True, **{f: {"Value": False} for f in sorted(others)}}
+            manager["Displays"].append(dict(display, Name="Robot frames", **{"Show Names": False}, Frames={
+                "All Enabled": True, **{f: {"Value": False} for f in sorted(agents | {scene.fixed_frame})}}))
     for k, topic in enumerate(odometry):
         manager["Displays"].append({
             "Class": "rviz/Odometry", "Enabled": True, "Name": topic, "Topic": topic, "Keep": 1,
@@ -422,11 +435,12 @@ def start_capture(procs, display, width, height, fps, path):
     return capture
 
 
-def start_player(procs, args, first, span, topics, env, rviz):
+def start_player(procs, args, contents, first, span, topics, env, rviz):
     """rosbag play of `span` seconds of the bag from bag time `first`, paused at its first message
     once rviz has connected to every topic it plays."""
-    cmd = ["rosbag", "play", "--clock", "--pause", "--rate", repr(args.speed), "--start", repr(args.start),
-           "--duration", repr(span), "--wait-for-subscribers", "--delay", "0.5"] + args.bags + ["--topics"] + topics
+    cmd = ["rosbag", "play", "--clock", "--pause", "--rate", repr(args.speed), "--start",
+           repr(max(0.0, first - contents.start)), "--duration", repr(span), "--wait-for-subscribers", "--delay",
+           "0.5"] + contents.parts + ["--topics"] + topics
     player = procs.start("play", cmd, env=env, stdout=subprocess.PIPE, stdin=subprocess.PIPE)
     read_until(procs, player, rviz, b"[PAUSED", STARTUP_TIMEOUT)
     return player
@@ -556,12 +570,14 @@ def package_path():
 
 def render(args, procs, tmp, progress):
     contents = BagContents(args.bags)
-    length = contents.end - contents.start
-    if args.start >= length:
-        fail(f"--from {args.start}: the bag lasts only {length:.3f} s")
-    span = (length if args.end is None else min(args.end, length)) - args.start
-    _, markers, odometry, topics = choose_topics(contents, args.ns)
-    first = contents.start + args.start
+    prefix, markers, odometry, topics = choose_topics(contents, args.ns)
+    run = RunSpan(contents, prefix + "/formation/status", markers, args.start, args.end)
+    if run.on_wall_time:
+        # A timed or robots bag: replay a copy on the run's clock (variational_formation/run_clock.py).
+        copy = os.path.join(tmp, "run.bag")
+        run.write_on_run_time(contents, topics, copy)
+        contents = BagContents([copy])
+    first, span = run.first, run.last - run.first
     scene = Scene(contents, markers, first, first + span)
     config = os.path.join(tmp, "formation.rviz")
     with open(config, "w") as f:
@@ -574,7 +590,7 @@ def render(args, procs, tmp, progress):
     env["DISPLAY"] = display
     rviz = procs.start("rviz", ["rviz", "-d", config, "--fullscreen", "__name:=render_rviz"], env=env)
     wait_for_rviz(procs, rviz, master, [t for t in topics if t != "/tf_static"])
-    player = start_player(procs, args, first, span, topics, env, rviz)
+    player = start_player(procs, args, contents, first, span, topics, env, rviz)
     timings = {"start-up": time.time()}
     capture_path = os.path.join(tmp, "capture.mkv")
     capture = start_capture(procs, display, args.width, args.height, args.fps, capture_path)
@@ -601,7 +617,7 @@ def render(args, procs, tmp, progress):
     offset = started + latency - start_time - 0.5 / args.fps
     encode(capture_path, max(0.0, offset), played, args.out, args.fps)
     timings["encoding"] = time.time()
-    return args.start, args.start + span, played, timings
+    return run.start, run.end, played, timings
 
 
 def main():

@@ -1,17 +1,31 @@
 #!/usr/bin/env bash
-# Runs formation.launch and tells a good run from a failed one: roslaunch itself exits 0 even
-# when a required node failed, so this reads the result file the monitor writes
-# (output_dir/<name>.result.yaml). Exit status 0 only if the run succeeded (or an unbounded run
-# was stopped); otherwise 1, with the monitor's reason, or roslaunch's own status if no result
-# was written (a bad argument or scenario stops the launch before the monitor runs).
-# usage: run_formation.sh [roslaunch args...] scenario:=S [output_dir:=DIR] [other formation.launch args]
+# Runs formation.launch, or robots.launch with launch:=robots, and tells a good run from a
+# failed one: roslaunch itself exits 0 even when a required node failed, so this reads the
+# result file the monitor writes (output_dir/<name>.result.yaml). Exit status 0 only if the run
+# succeeded (or an unbounded run was stopped); otherwise 1, with the monitor's reason, or
+# roslaunch's own status if no result was written (a bad argument or scenario stops the launch
+# before the monitor runs); 2 for a launch:= other than formation or robots.
+# usage: run_formation.sh [launch:=formation|robots] [roslaunch args...] scenario:=S [output_dir:=DIR] [other args of the launch file]
 set -uo pipefail
 case "${1:-}" in
   -h|--help) sed -n '2,/^# usage/p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
 esac
-scenario=tetrahedron
-output_dir="$HOME/.ros"
+launch=formation
+args=()
 for a in "$@"; do
+  case "$a" in
+    launch:=*) launch="${a#launch:=}" ;;
+    *) args+=("$a") ;;
+  esac
+done
+# Each launch file's own default scenario.
+case "$launch" in
+  formation) scenario=tetrahedron ;;
+  robots) scenario=hexagon ;;
+  *) echo "run_formation: launch: expected formation or robots, got '$launch'" >&2; exit 2 ;;
+esac
+output_dir="$HOME/.ros"
+for a in "${args[@]}"; do
   case "$a" in
     scenario:=*) scenario="${a#scenario:=}" ;;
     output_dir:=*) output_dir="${a#output_dir:=}" ;;
@@ -22,7 +36,7 @@ name="$(basename "$scenario" .yaml)"
 ns="${ROS_NAMESPACE:-}"; ns="${ns#/}"; ns="${ns%/}"; prefix="${ns//\//_}"
 result="$output_dir/${prefix:+${prefix}_}$name.result.yaml"
 rm -f "$result"
-roslaunch variational_formation formation.launch "$@"
+roslaunch variational_formation "$launch.launch" "${args[@]}"
 status=$?
 if [ ! -f "$result" ]; then
   echo "run_formation: the run failed before the monitor started (roslaunch exit status $status; see above)" >&2

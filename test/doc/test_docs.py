@@ -14,14 +14,24 @@
 - Every relative link in README.md and doc/*.md reaches an existing file and heading.
 - No other page keeps a parameter table of its own (one list), and README.md has at most 200
   lines.
+- Every command in README.md and doc/*.md runs on a fresh machine after scripts/test.sh: the ROS
+  tools, and the package of each `rosrun PKG EXE` and `roslaunch PKG FILE`, come from a Debian
+  package that package.xml's keys install (scripts/debian_packages.txt, with its dependencies),
+  the executable or launch file exists, and this package's programs, launch files and
+  run_formation.sh take the options and arguments the command gives them.
+- No file of the repository refers to a file outside it (the docs stand alone).
 
   test_docs.py [--gtest_output=xml:PATH]     (rosunit; --text for a plain run)
 """
 import ast
 import os
 import re
+import shutil
 import sys
 import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import doc_commands  # noqa: E402
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 API = os.path.join(ROOT, "doc", "ros_api.md")
@@ -508,6 +518,105 @@ class Docs(unittest.TestCase):
                 elif anchor and full.endswith(".md") and anchor not in heading_slugs(read(full)):
                     broken.append(where + " (no such heading)")
         self.assertEqual(broken, [], "broken links:\n" + "\n".join(broken))
+
+    def test_commands_work_on_a_fresh_machine(self):
+        import roslib.packages
+        import rospkg
+        keys = doc_commands.declared_keys()
+        installed = doc_commands.installed_closure(doc_commands.mapped_debian_packages(keys))
+        programs, launches = doc_commands.own_programs(), doc_commands.own_launch_files()
+        documented = set(self.doc.specs) | set(self.doc.references)
+        wrong, checked, provided = [], 0, []  # provided: (where, what, path) to look up in dpkg
+
+        for where, words in doc_commands.every_command():
+            tool = words[0]
+            if re.fullmatch(r"(ros|catkin)\w*", tool):
+                checked += 1
+                if shutil.which(tool) is None:
+                    wrong.append(f"{where}: {tool}: no such program")
+                    continue
+                provided.append((where, tool, shutil.which(tool)))
+            if tool not in ("rosrun", "roslaunch"):
+                continue
+            positional = [w for w in words[1:] if not w.startswith("-") and ":=" not in w]
+            if tool == "roslaunch" and positional and positional[0].endswith(".launch"):
+                continue  # roslaunch FILE: a file of the user's
+            if len(positional) < 2:
+                wrong.append(f"{where}: {' '.join(words)}: expected {tool} PACKAGE NAME")
+                continue
+            pkg, name = positional[:2]
+            command = f"{tool} {pkg} {name}"
+            if pkg == doc_commands.PKG:
+                self.check_own_command(where, tool, name, words, programs, launches, documented, wrong)
+                continue
+            if pkg not in keys:
+                wrong.append(f"{where}: {command}: package.xml does not depend on {pkg}")
+                continue
+            try:
+                found = (roslib.packages.find_node(pkg, name) if tool == "rosrun"
+                         else [roslib.packages.find_resource(pkg, name)[0]])
+            except (rospkg.ResourceNotFound, IndexError):
+                found = []
+            if not found:
+                wrong.append(f"{where}: {command}: {pkg} has no {name}")
+            else:
+                provided.append((where, command, found[0]))
+        owners = doc_commands.owners([path for _, _, path in provided])
+        for where, what, path in provided:
+            if owners[path] not in installed:
+                wrong.append(f"{where}: {what} ({path}) comes from Debian package {owners[path]}, which "
+                             "scripts/test.sh does not install (package.xml + scripts/debian_packages.txt)")
+        self.assertGreater(checked, 50, "implausibly few commands found in README.md and doc/")
+        self.assertEqual(wrong, [], "commands that fail on a fresh machine:\n" + "\n".join(wrong))
+
+    def check_own_command(self, where, tool, name, words, programs, launches, documented, wrong):
+        """rosrun/roslaunch of this package: the program or launch file exists, takes each --option
+        given (a string literal of its sources), each launch argument name:=value (run_formation.sh:
+        of the launch file it runs) and each private parameter _name:=value (doc/ros_api.md)."""
+        command = f"{tool} {doc_commands.PKG} {name}"
+        if tool == "roslaunch":
+            if name not in launches:
+                wrong.append(f"{where}: {command}: no such launch file in launch/")
+                return
+            arguments = doc_commands.launch_args(launches[name])
+        elif name not in programs:
+            wrong.append(f"{where}: {command}: neither in scripts/ nor built by cmake/*.cmake")
+            return
+        elif name == "run_formation.sh":
+            launch = "robots.launch" if "launch:=robots" in words else "formation.launch"
+            arguments = doc_commands.launch_args(launches[launch]) | {"launch"}
+        else:
+            arguments = None
+        sources = "".join(read(p) for p in doc_commands.program_sources(name, programs)) if tool == "rosrun" else ""
+        for word in words[3:]:
+            option, assigned = word.split("=", 1)[0], word.split(":=", 1)[0]
+            if option.startswith("--") and f'"{option}"' not in sources and f"'{option}'" not in sources:
+                wrong.append(f"{where}: {command}: no option {option}")
+            elif ":=" in word and arguments is not None and assigned not in arguments:
+                wrong.append(f"{where}: {command}: no argument {assigned}")
+            elif ":=" in word and arguments is None and re.fullmatch(r"_[a-z]\w*", assigned) and (
+                    assigned[1:] not in documented):
+                wrong.append(f"{where}: {command}: no parameter ~{assigned[1:]} in doc/ros_api.md")
+
+    def test_no_reference_outside_the_repository(self):
+        # Every page named anywhere in the repository is one of its own, and no path climbs out
+        # of it (the design notes and style guide of the workplace are not shipped).
+        pages = {n for _, _, names in os.walk(ROOT) for n in names if n.endswith(".md")}
+        outside = []
+        for folder, dirs, names in os.walk(ROOT):
+            dirs[:] = [d for d in dirs if not d.startswith(".") and d not in ("output", "build", "devel")]
+            for name in names:
+                path = os.path.join(folder, name)
+                try:
+                    text = read(path)
+                except (UnicodeDecodeError, OSError):
+                    continue  # a picture
+                for number, line in enumerate(text.splitlines(), 1):
+                    named = {m for m in re.findall(r"([\w-]+\.md)\b", line) if m not in pages}
+                    climbs = re.findall(r"\.\./shared\b|/work/(?:shared)\b", line)
+                    if named or climbs:
+                        outside.append(f"{relative(path)}:{number}: {', '.join(sorted(named) + climbs)}")
+        self.assertEqual(outside, [], "references to files outside the repository:\n" + "\n".join(outside))
 
     def test_readme_is_a_front_door(self):
         with open(os.path.join(ROOT, "README.md"), encoding="utf-8") as f:

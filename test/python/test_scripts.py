@@ -1,12 +1,13 @@
 """Each script of scripts/ (except plot_bag.py and plot_simulation.py, tested beside their own
 changes, and render_bag.py) run on a small input: the files it writes, and one bad input."""
 import os
+import socket
 import struct
 import xml.etree.ElementTree as ElementTree
 
 import numpy as np
 
-from vf_harness import REPO, TempDirTestCase, run, tool
+from vf_harness import REPO, TempDirTestCase, run, script, tool
 
 HEXAGON = os.path.join(REPO, "config", "hexagon.yaml")
 SQUARE = os.path.join(REPO, "config", "square.yaml")
@@ -140,3 +141,34 @@ class FailureReasonsTest(TempDirTestCase):
         result = self.run_script("failure_reasons.py", self.path("results"), "100")
         self.assertSucceeded(result)
         self.assertEqual(result.stdout.strip().splitlines(), ["r.xml: bad: distance 0.3 > 0.01"])
+
+
+class RunFormationTest(TempDirTestCase):
+    """run_formation.sh with launch:=robots runs robots.launch (its default scenario, the hexagon:
+    300 steps at rate 1, 4.2 s), with formation.launch's result and exit status."""
+
+    def run_formation(self, *args, timeout=180):
+        with socket.socket() as s:
+            s.bind(("127.0.0.1", 0))
+            port = s.getsockname()[1]
+        env = dict(os.environ, ROS_MASTER_URI=f"http://localhost:{port}", ROS_HOME=self.path("ros_home"))
+        return run(["bash", script("run_formation.sh"), "-p", str(port)] + list(args), env=env, timeout=timeout)
+
+    def test_robots_launch_run_succeeds(self):
+        result = self.run_formation("launch:=robots", f"output_dir:={self.tmp}")
+        self.assertSucceeded(result)
+        with open(self.path("hexagon.result.yaml")) as f:
+            self.assertIn("result: succeeded", f.read())
+        # robots.launch, not formation.launch, ran: it writes the robots' launch file.
+        written = os.listdir(self.path("ros_home", "variational_formation"))
+        self.assertTrue(any(n.startswith("hexagon_robots_") for n in written), written)
+        self.assertIn("robot_sim", result.stdout)
+
+    def test_robots_launch_that_cannot_start_fails(self):
+        result = self.run_formation("launch:=robots", f"scenario:={self.path('missing.yaml')}",
+                                    f"output_dir:={self.tmp}", timeout=60)
+        self.assertNotEqual(result.returncode, 0, result.stdout)
+        self.assertIn("run_formation: the run failed before the monitor started", result.stderr)
+
+    def test_unknown_launch(self):
+        self.assertBadInput(self.run_formation("launch:=agent"), "launch", "formation or robots", "'agent'")

@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """rostest (render.test): render_bag.py turns the hexagon's bag, recorded by formation.launch in
 the same launch and split in parts (hexagon.bag, hexagon_1.bag, ...), into an MP4 and a GIF.
+With the argument `robots` (render.test kind:=robots), the bag of robots.launch instead.
 
 Checks, on both videos: ffprobe's duration is the run's (4.2 s) over the speed, within 10%, at
 the asked size; no frame is blank; the last frame shows every agent's colour; the first and last
@@ -9,6 +10,12 @@ it, after a good run, after Ctrl-C, or after a failure. Bad inputs get one line 
 non-zero status: no bag, an empty bag, no ffmpeg on PATH, a display that cannot start (taken by
 another X server), rviz that dies.
 
+robots.launch's bag is on wall time and holds the robots' messages until after the run's last
+step (here 1 s after it, as a launch ending at the run's end would), and from before its first
+step or from the step at which rosbag record joined: its video is the run from the first
+recorded step (within two steps) to the last, (4.2 s - that step's t) over the speed within 1.5
+frames, not the bag's length; 90 % of the frames and the last one show every agent.
+
 VF_TEST_DISPLAY=:N (optional) makes every render use X display :N, and the busy-display case
 N + 1; by default Xvfb picks free ones.
 
@@ -16,6 +23,7 @@ Private parameters:
   output_dir   where formation.launch writes the bag and the result file (removed after)
 """
 import os
+import re
 import select
 import shutil
 import signal
@@ -35,7 +43,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import vf_rostest  # noqa: E402
 
 PKG = vf_rostest.PKG
-RUN_SECONDS = 4.2  # config/hexagon.yaml: 300 steps of 0.014 s
+RUN_SECONDS, STEP = 4.2, 0.014  # config/hexagon.yaml: 300 steps of 0.014 s
+AFTER_THE_RUN = 1.0  # [s] robots: the recording goes on this long after the run
 SPEED, FPS, WIDTH, HEIGHT = 2.0, 20, 640, 480
 # Standard deviation of the pixel values (0..255) of a frame: measured 12.5 for rviz's empty grid
 # at this size, 21 to 23 with the hexagon drawn.
@@ -120,10 +129,11 @@ class Watched:
         return left
 
 
-@vf_rostest.reported_setup
-class RenderTest(unittest.TestCase):
+class RecordedHexagon(unittest.TestCase):
+    """The hexagon's run that the launch records (its result, its bag), and a folder for videos."""
+
     @classmethod
-    def setUpClass(cls):
+    def wait_for_the_run(cls):
         rospy.init_node("render_test")
         cls.out = rospy.get_param("~output_dir")
         cls.result = vf_rostest.wait_for_result(os.path.join(cls.out, "hexagon.result.yaml"), 120.0)
@@ -131,9 +141,23 @@ class RenderTest(unittest.TestCase):
         cls.tmp = tempfile.mkdtemp(prefix="render_test_")
 
     @classmethod
-    def tearDownClass(cls):
+    def remove_files(cls):
         shutil.rmtree(cls.out, ignore_errors=True)
         shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def setUp(self):
+        self.assertEqual(self.result.get("result"), "succeeded", f"the recorded run: {self.result}")
+
+
+@vf_rostest.reported_setup
+class RenderTest(RecordedHexagon):
+    @classmethod
+    def setUpClass(cls):
+        cls.wait_for_the_run()
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.remove_files()
 
     def render(self, *args, env=None):
         display = test_display()
@@ -150,9 +174,6 @@ class RenderTest(unittest.TestCase):
         self.assertEqual(len(err.strip().splitlines()), 1, f"one line on stderr, got: {err}")
         for word in words:
             self.assertIn(word, err)
-
-    def setUp(self):
-        self.assertEqual(self.result.get("result"), "succeeded", f"the recorded run: {self.result}")
 
     def test_videos_of_the_run(self):
         self.assertTrue(os.path.exists(self.bag[:-len(".bag")] + "_1.bag"), "the recording is not split")
@@ -274,5 +295,55 @@ class RenderTest(unittest.TestCase):
         self.assert_nothing_left(watched)
 
 
+@vf_rostest.reported_setup
+class RenderRobotsTest(RecordedHexagon):
+    @classmethod
+    def setUpClass(cls):
+        cls.wait_for_the_run()
+        # The recording goes on after the run until the launch ends; then a clean stop closes the bag.
+        time.sleep(AFTER_THE_RUN)
+        subprocess.run(["rosnode", "kill", "/formation/recorder"], capture_output=True)
+        end = time.time() + 15
+        while not os.path.exists(cls.bag) and time.time() < end:
+            time.sleep(0.2)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.remove_files()
+
+    def test_the_video_is_the_run(self):
+        import rosbag
+        with rosbag.Bag(self.bag) as bag:
+            length = bag.get_end_time() - bag.get_start_time()
+            # rosbag record may join some steps into the run (the timed monitor does not wait for it).
+            joined = next(bag.read_messages(topics=["/formation/status"]))[1].time
+        # What makes the check below tell the run from the bag.
+        self.assertGreater(length, RUN_SECONDS - joined + AFTER_THE_RUN, "the bag holds no time around the run")
+        video = os.path.join(self.tmp, "robots.mp4")
+        display = test_display()
+        watched = Watched([self.bag, "--out", video, "--speed", str(SPEED), "--fps", str(FPS), "--size",
+                           f"{WIDTH}x{HEIGHT}"] + (["--display", display] if display else []))
+        code, out, err = watched.finish()
+        self.assertEqual(code, 0, err)
+        # The run from its first recorded step (or the next, whose markers the bag holds) to its end.
+        shown = re.search(r"([0-9.]+)\.\.([0-9.]+) s of the run", out)
+        self.assertTrue(shown, out)
+        self.assertAlmostEqual(float(shown[1]), joined, delta=2 * STEP + 0.005, msg=out)
+        self.assertEqual(shown[2], f"{RUN_SECONDS:.2f}", out)
+        probe = subprocess.run(["ffprobe", "-v", "error", "-show_entries", "format=duration", "-of",
+                                "default=noprint_wrappers=1:nokey=1", video], capture_output=True, text=True, check=True)
+        # The monitor's ticks: within one of the run's steps at each end, and a frame.
+        self.assertAlmostEqual(float(probe.stdout), (RUN_SECONDS - float(shown[1])) / SPEED, delta=1.5 / FPS,
+                               msg=f"the video's length; the bag lasts {length:.2f} s")
+        raw = subprocess.run(["ffmpeg", "-v", "error", "-i", video, "-f", "rawvideo", "-pix_fmt", "rgb24", "-"],
+                             capture_output=True, check=True).stdout
+        frames = np.frombuffer(raw, dtype=np.uint8).reshape(-1, HEIGHT, WIDTH, 3)
+        # The markers of the run throughout: rviz may draw the first picture's markers a frame late.
+        without = [k for k, frame in enumerate(frames)
+                   if min(vf_rostest.agent_colour_pixels(frame / 255.0)) <= 30]
+        self.assertLessEqual(len(without), 0.1 * len(frames), f"frames without every agent's colour: {without}")
+        self.assertNotIn(len(frames) - 1, without, "the last frame lacks an agent")
+
+
 if __name__ == "__main__":
-    rostest.rosrun(PKG, "render_test", RenderTest, sys.argv)
+    rostest.rosrun(PKG, "render_test", RenderRobotsTest if "robots" in sys.argv[1:] else RenderTest, sys.argv)
