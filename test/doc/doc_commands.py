@@ -83,7 +83,8 @@ def own_programs():
     for path in glob.glob(os.path.join(ROOT, "cmake", "*.cmake")):
         text = read(path)
         loops = {m[1]: m[2].split() for m in re.finditer(r"foreach\((\w+)\s+([^)]*)\)", text)}
-        for name, files in re.findall(r"add_executable\(\s*(\S+)\s+([^)]*)\)", text):
+        # add_executable, and vf_add_tool (cmake/functions.cmake), which wraps it for the CLIs.
+        for name, files in re.findall(r"(?:add_executable|vf_add_tool)\(\s*(\S+)\s+([^)]*)\)", text):
             var = re.fullmatch(r"\$\{(\w+)\}", name)
             for each in loops.get(var[1], []) if var else [name]:
                 programs[each] = [os.path.join(ROOT, f.replace("${" + var[1] + "}", each) if var else f)
