@@ -117,15 +117,16 @@ class ManoeuvreRun(unittest.TestCase, vf_rostest.RunChecks):
         up = Twist()
         up.linear.z = 0.3  # a 2D formation has no z velocity
         velocity.publish(up)
-        # A good command from a node that is not in ~commanders.
-        subprocess.run(["rostopic", "pub", "-1", f"{NS}/cmd_vel", "geometry_msgs/Twist",
-                        "{linear: {x: 0.1, y: 0.0, z: 0.0}}", "__name:=intruder"], capture_output=True, timeout=30)
-        cls.bad_sent = 4
-        # Beyond the formation's ~max_speed (2 m/s): saturated, kept and counted.
+        # Beyond the formation's ~max_speed (2 m/s): saturated, kept and counted (before the
+        # intruder below, whose rostopic pub takes seconds).
         fast = Twist()
         fast.linear.x = 1000.0
         velocity.publish(fast)
         cls.saturated_sent = 1
+        # A good command from a node that is not in ~commanders.
+        subprocess.run(["rostopic", "pub", "-1", f"{NS}/cmd_vel", "geometry_msgs/Twist",
+                        "{linear: {x: 0.1, y: 0.0, z: 0.0}}", "__name:=intruder"], capture_output=True, timeout=30)
+        cls.bad_sent = 4
 
     @classmethod
     def tearDownClass(cls):
