@@ -65,7 +65,7 @@ class ManoeuvreRun(unittest.TestCase, vf_rostest.RunChecks):
         assert velocity.get_num_connections() and scale.get_num_connections(), "the monitor never subscribed"
         # Commands at steps drawn over the first 70% of the run (wall time: step h / rate).
         at = sorted(rng.sample(range(50, int(0.7 * steps)), COMMANDS))
-        cls.sent, cls.bad_sent, cls.saturated_sent, cls.kills = [], 0, 0, []
+        cls.sent, cls.bad_sent, cls.saturated_sent, cls.kills, cls.intruder = [], 0, 0, [], None
         kill_agent_after, kill_monitor_after = 2, 4  # commands sent before each kill (faults)
         for n, step in enumerate(at):
             cls.wait_for_step(step, steps * h / rate + 60)
@@ -90,6 +90,8 @@ class ManoeuvreRun(unittest.TestCase, vf_rostest.RunChecks):
                 time.sleep(0.5)
                 vf_rostest.node_pid(victim, timeout=30.0)  # respawned
         print(f"manoeuvre_run_test: sent {cls.sent}", flush=True)
+        if cls.intruder is not None:
+            cls.intruder.wait(timeout=60)
         status.unregister()
         name = "hexagon_manoeuvre"
         cls.result = vf_rostest.wait_for_result(os.path.join(cls.out, name + ".result.yaml"), steps * h / rate + 90)
@@ -117,15 +119,17 @@ class ManoeuvreRun(unittest.TestCase, vf_rostest.RunChecks):
         up = Twist()
         up.linear.z = 0.3  # a 2D formation has no z velocity
         velocity.publish(up)
-        # Beyond the formation's ~max_speed (2 m/s): saturated, kept and counted (before the
-        # intruder below, whose rostopic pub takes seconds).
+        # Beyond the formation's ~max_speed (2 m/s): saturated, kept and counted.
         fast = Twist()
         fast.linear.x = 1000.0
         velocity.publish(fast)
         cls.saturated_sent = 1
-        # A good command from a node that is not in ~commanders.
-        subprocess.run(["rostopic", "pub", "-1", f"{NS}/cmd_vel", "geometry_msgs/Twist",
-                        "{linear: {x: 0.1, y: 0.0, z: 0.0}}", "__name:=intruder"], capture_output=True, timeout=30)
+        # A good command from a node that is not in ~commanders. Its rostopic pub takes seconds
+        # (start-up, and 3 s latched after publishing): in the background, so that the commands
+        # after it still go out at their steps.
+        cls.intruder = subprocess.Popen(["rostopic", "pub", "-1", f"{NS}/cmd_vel", "geometry_msgs/Twist",
+                                         "{linear: {x: 0.1, y: 0.0, z: 0.0}}", "__name:=intruder"],
+                                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         cls.bad_sent = 4
 
     @classmethod
