@@ -9,7 +9,7 @@ target_sources(variational_formation_ros PRIVATE src/ros/timed_agent_node.cpp sr
   src/ros/timed_agent_robot.cpp)
 # The monitor's two modes over its shared wiring, and the bounded pool of service calls.
 target_sources(variational_formation_ros PRIVATE src/ros/lockstep_monitor.cpp src/ros/monitor_commands.cpp
-  src/ros/timed_monitor.cpp src/ros/monitor_outputs.cpp
+  src/ros/monitor_parameters.cpp src/ros/timed_monitor.cpp src/ros/monitor_outputs.cpp
   src/ros/recorder_bag.cpp src/ros/recorder_commands.cpp
   src/ros/service_call.cpp src/ros/state_batch.cpp src/ros/periodic_call.cpp)
 add_dependencies(variational_formation_ros ${PROJECT_NAME}_gencfg)
@@ -70,6 +70,9 @@ if(CATKIN_ENABLE_TESTING)
     "case:=reconfigure scenario_name:=timed_hexagon_kappa4 delay:=0.07 reconfigure_kappa:=13"
     "case:=command command:=0.3_-0.2")
   add_rostest(test/ros/timed_bad_input.test)
+  # kappa during a run with the real dynparam: an agent's server and the formation's (the monitor's).
+  add_rostest(test/ros/kappa_reconfigure.test ARGS mode:=timed)
+  add_rostest(test/ros/kappa_reconfigure.test ARGS mode:=lockstep)
   # Live commands in a recorded lockstep run (test/ros/manoeuvre_run.test): with bad ones; with
   # an agent and the monitor killed during the manoeuvre.
   add_rostest(test/ros/manoeuvre_run.test ARGS case:=live seed:=3)

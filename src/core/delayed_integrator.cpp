@@ -4,6 +4,7 @@
 #include <string>
 
 #include "variational_formation/core/error.hpp"
+#include "variational_formation/core/number_checks.hpp"
 #include "variational_formation/core/metrics.hpp"
 
 namespace vf {
@@ -13,8 +14,7 @@ void validateDelaySettings(const DelaySettings& s) {
     throw InvalidInput("--delay-steps: must be an integer >= 0, got " + std::to_string(s.delaySteps));
   }
   if (!(s.lossProbability >= 0.0 && s.lossProbability <= 1.0)) {
-    throw InvalidInput("--loss: must be a probability in [0, 1], got " +
-                       std::to_string(s.lossProbability));
+    throw InvalidInput("--loss: must be a probability in [0, 1], got " + formatNumber(s.lossProbability));
   }
 }
 

@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 
 #include "variational_formation/core/error.hpp"
 
@@ -23,6 +24,13 @@ std::string formatNumber(double value) {
   char text[32];
   const auto end = std::to_chars(text, text + sizeof text, value).ptr;
   return std::string(text, end);
+}
+
+std::string formatRounded(double value) {
+  if (!std::isfinite(value)) return formatNumber(value);
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", value);
+  return text;
 }
 
 void requireFiniteAtLeast(const std::string& field, double value, double lower, const std::string& unit) {

@@ -16,8 +16,9 @@
 
 namespace vf {
 
-RobotLagCheck checkRobotLag(const Scenario& scenario, double lag, double tickPeriod) {
-  requireFiniteAtLeast("lag", lag, 0.0, "s");
+RobotLagCheck checkRobotLag(const Scenario& scenario, double lag, double tickPeriod, RobotFeedback feedback,
+                            const std::string& optionPrefix) {
+  requireFiniteAtLeast(optionPrefix + "robot_lag", lag, 0.0, "s");
   requireFiniteAbove("tick period", tickPeriod, 0.0, "s");
   const double h = scenario.timeStep;
   RobotLagCheck check;
@@ -30,13 +31,26 @@ RobotLagCheck checkRobotLag(const Scenario& scenario, double lag, double tickPer
   check.capped = margin.capped;
   check.marginSeconds = std::max(0L, margin.margin) * h;
   check.exceeded = !margin.capped && (margin.margin < 0 || check.lagPlusTick > check.marginSeconds);
-  if (check.exceeded) {
-    check.warning = "robot lag " + formatNumber(lag) + " s plus one tick " + formatNumber(tickPeriod) +
-                    " s = " + formatNumber(check.lagPlusTick) + " s exceeds the delay margin D* = " +
-                    std::to_string(margin.margin) + " steps = " + formatNumber(check.marginSeconds) +
-                    " s (kappa " + formatNumber(scenario.dampingGain) + ", h " + formatNumber(h) +
-                    "): with odometry feedback the robots may never form the shape; a larger kappa or "
-                    "a smaller h widens the margin, or use integrated feedback (doc/robots.md)";
+  check.applies = feedback == RobotFeedback::Odometry;
+  const std::string& o = optionPrefix;
+  const std::string lagText = "robot lag " + formatRounded(lag) + " s plus one tick " + formatRounded(tickPeriod) +
+                              " s = " + formatRounded(check.lagPlusTick) + " s";
+  const std::string comparison =
+      margin.capped ? lagText + " is within the delay margin (stable for every delay up to it at kappa " +
+                          formatRounded(scenario.dampingGain) + ", h " + formatRounded(h) + ")"
+                    : lagText + (check.exceeded ? " exceeds" : " is within") + " the delay margin D* = " +
+                          std::to_string(margin.margin) + " steps = " + formatRounded(check.marginSeconds) +
+                          " s (kappa " + formatRounded(scenario.dampingGain) + ", h " + formatRounded(h) + ")";
+  if (!check.applies) {
+    check.info = o + "feedback integrated: " + comparison + "; the margin bounds " + o + "robot_lag only with " + o +
+                 "feedback odometry: here the formation runs on the agents' own states and the lag reaches it "
+                 "only through the " + o + "correction_time pull (doc/robots.md)";
+  } else if (check.exceeded) {
+    check.warning = o + "feedback odometry, " + o + "robot_lag: " + comparison +
+                    ": the robots may never form the shape; a larger kappa or a smaller h widens the margin, or "
+                    "use " + o + "feedback integrated (doc/robots.md)";
+  } else {
+    check.info = o + "feedback odometry, " + o + "robot_lag: " + comparison;
   }
   return check;
 }

@@ -210,7 +210,7 @@ void TimedAgent::setMeasuredPosition(const std::vector<double>& position) {
 }
 
 void TimedAgent::setDampingGain(double dampingGain) {
-  requireFiniteAtLeast("kappa", dampingGain, 0.0, "1/s");
+  validateDynamics(coefficients_.timeStep, dampingGain);  // the scenario's check of kappa
   coefficients_ = VariationalCoefficients(coefficients_.timeStep, dampingGain);
 }
 

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
 #include <utility>
 
 #include "variational_formation/core/error.hpp"
@@ -22,25 +25,34 @@ std::string show(double x) {
   return std::string(buffer, result.ptr);
 }
 
+// A limit x > 0 for a person to read, rounded down to formatRounded's digits: every value up to
+// the text is within the limit.
+std::string roundedDown(double x) {
+  std::string text = formatRounded(x);
+  for (double step = std::pow(10.0, std::floor(std::log10(x)) - 5); std::stod(text) > x;) {
+    text = formatRounded(std::stod(text) - step);
+  }
+  return text;
+}
+
 }  // namespace
 
-void validateDynamics(double timeStep, double dampingGain, const FieldNames& names) {
+std::string dynamicsProblem(double timeStep, double dampingGain, const FieldNames& names) {
   const double h = timeStep, kappa = dampingGain;
   if (!(std::isfinite(kappa) && kappa >= 0.0)) {
-    throw InvalidInput(names.dampingGain + ": must be finite and >= 0, got " + show(kappa));
+    return names.dampingGain + ": must be finite and >= 0, got " + show(kappa);
   }
   if (!(std::isfinite(h) && h > 0.0)) {
-    throw InvalidInput(names.timeStep + ": must be finite and > 0, got " + show(h));
+    return names.timeStep + ": must be finite and > 0, got " + show(h);
   }
   if (h > limits::kMaxTimeStep) {
-    throw InvalidInput(names.timeStep + ": must be <= " + show(limits::kMaxTimeStep) +
-                       " s (beyond it 2 h^2 overflows), got " + show(h));
+    return names.timeStep + ": must be <= " + show(limits::kMaxTimeStep) +
+           " s (beyond it 2 h^2 overflows), got " + show(h);
   }
   if (kappa * h > limits::kMaxDampingTimeStep) {
-    throw InvalidInput(names.dampingGain + " * " + names.timeStep + ": must be <= " +
-                       show(limits::kMaxDampingTimeStep) +
-                       " (beyond it e^{-kappa h} underflows and the update freezes), got " +
-                       show(kappa) + " * " + show(h) + " = " + show(kappa * h));
+    return names.dampingGain + " * " + names.timeStep + ": must be <= " + show(limits::kMaxDampingTimeStep) +
+           " (beyond it e^{-kappa h} underflows and the update freezes), got " + show(kappa) + " * " + show(h) +
+           " = " + formatRounded(kappa * h);
   }
   // e^{-kappa h} is normal now; the position gains can still underflow when h is tiny.
   const VariationalCoefficients c(h, kappa);
@@ -48,12 +60,47 @@ void validateDynamics(double timeStep, double dampingGain, const FieldNames& nam
                                                   {"2h/(1 + e^{kappa h})", c.startGain}};
   for (const auto& [name, gain] : gains) {
     if (!(gain >= limits::kSmallestGain)) {
-      throw InvalidInput(names.timeStep + ": too small, the gain " + name + " = " + show(gain) +
-                         " must be >= " + show(limits::kSmallestGain) +
-                         " (the smallest normal double), got h = " + show(h) + " with kappa = " +
-                         show(kappa));
+      return names.timeStep + ": too small, the gain " + name + " = " + formatRounded(gain) + " must be >= " +
+             show(limits::kSmallestGain) + " (the smallest normal double), got h = " + show(h) +
+             " with kappa = " + show(kappa);
     }
   }
+  return "";
+}
+
+void validateDynamics(double timeStep, double dampingGain, const FieldNames& names) {
+  const std::string problem = dynamicsProblem(timeStep, dampingGain, names);
+  if (!problem.empty()) throw InvalidInput(problem);
+}
+
+double maxDampingGain(double timeStep) {
+  validateDynamics(timeStep, 0.0);  // a refused h has no kappa at all
+  // The accepted kappas are [0, K] (every limit is monotone in kappa). Non-negative doubles are
+  // ordered as their bit patterns: bisect those, so K is the exact edge of dynamicsProblem.
+  const auto bitsOf = [](double x) {
+    std::uint64_t b;
+    std::memcpy(&b, &x, sizeof b);
+    return b;
+  };
+  const auto valueOf = [](std::uint64_t b) {
+    double x;
+    std::memcpy(&x, &b, sizeof x);
+    return x;
+  };
+  std::uint64_t accepted = bitsOf(0.0), refused = bitsOf(std::numeric_limits<double>::infinity());
+  while (refused - accepted > 1) {
+    const std::uint64_t mid = accepted + (refused - accepted) / 2;
+    (dynamicsProblem(timeStep, valueOf(mid), {}).empty() ? accepted : refused) = mid;
+  }
+  return valueOf(accepted);
+}
+
+std::optional<std::string> refuseDampingGain(double timeStep, double requested, double current,
+                                             const std::string& field) {
+  if (dynamicsProblem(timeStep, requested, {field, "time_step", "steps"}).empty()) return std::nullopt;
+  return field + ": " + formatNumber(requested) + " refused, outside the accepted range [0, " +
+         roundedDown(maxDampingGain(timeStep)) + "] 1/s at time step h = " + formatRounded(timeStep) +
+         " s; kappa stays " + formatNumber(current);
 }
 
 void validateSteps(long steps, bool requireBounded, const std::string& field) {
@@ -76,7 +123,7 @@ void validateRealTimeFactor(double realTimeFactor, double timeStep, const std::s
     throw InvalidInput(field + ": the pacing time_step / " + field + " must be <= " +
                        show(limits::kMaxPacingSeconds) + " s (a ROS duration), got " +
                        show(timeStep) + " / " + show(realTimeFactor) + " = " +
-                       show(timeStep / realTimeFactor) + " s");
+                       formatRounded(timeStep / realTimeFactor) + " s");
   }
 }
 
@@ -148,9 +195,9 @@ void validateCommand(const Command& c, int dimension, double timeStep, const Com
   }
   const double turn = timeStep * c.angularRate.norm();
   if (!(turn <= limits::kMaxTurnPerStep)) {
-    throw InvalidInput(names.angularRate + ": turns h |omega| = " + show(turn) + " rad per step, more than " +
+    throw InvalidInput(names.angularRate + ": turns h |omega| = " + formatRounded(turn) + " rad per step, more than " +
                        show(limits::kMaxTurnPerStep) + " (|omega| must be <= " +
-                       show(limits::kMaxTurnPerStep / timeStep) + " rad/s at h = " + show(timeStep) + ")");
+                       formatRounded(limits::kMaxTurnPerStep / timeStep) + " rad/s at h = " + show(timeStep) + ")");
   }
 }
 
@@ -188,8 +235,8 @@ void validateManoeuvre(Scenario& s, const Formation& formation, const FieldNames
       const double allowed = 0.5 * c.scale * softest;
       if (c.angularRate.norm() > allowed) {
         s.warnings.push_back("manoeuvre[" + std::to_string(i) + "].angular_rate: |omega| = " +
-                             show(c.angularRate.norm()) + " rad/s is above half the softest shape mode's frequency (" +
-                             show(allowed) + " rad/s at scale " + show(c.scale) +
+                             formatRounded(c.angularRate.norm()) + " rad/s is above half the softest shape mode's frequency (" +
+                             formatRounded(allowed) + " rad/s at scale " + show(c.scale) +
                              "): the turning formation may be slow to take its shape, or lose it");
       }
     }
@@ -204,7 +251,7 @@ void validateManoeuvre(Scenario& s, const Formation& formation, const FieldNames
     const double w = largestScale * maxStiffnessFrequency(formation, formation.desiredShape());
     if (!isLinearlyStable(s.timeStep, w, s.dampingGain)) {
       s.warnings.push_back("manoeuvre: " + names.timeStep + " = " + show(s.timeStep) +
-                           " exceeds the linear stability limit " + show(stableTimeStepLimit(w, s.dampingGain)) +
+                           " exceeds the linear stability limit " + formatRounded(stableTimeStepLimit(w, s.dampingGain)) +
                            " s of the shape scaled by " + show(largestScale));
     }
   }

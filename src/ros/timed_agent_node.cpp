@@ -66,6 +66,11 @@ TimedAgentNode::TimedAgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   reconfigure_ = std::make_unique<dynamic_reconfigure::Server<variational_formation::TimedAgentConfig>>(pnh);
   reconfigure_->setCallback(
       [this](variational_formation::TimedAgentConfig& config, uint32_t level) { onReconfigure(config, level); });
+  // The formation's kappa: the monitor's server in its namespace (MonitorNode::setUpParameters).
+  formationParametersSub_ = nh.subscribe<dynamic_reconfigure::Config>(
+      ros::names::append(ros::names::parentNamespace(monitor_), "parameter_updates"), 1,
+      boost::function<void(const ros::MessageEvent<dynamic_reconfigure::Config const>&)>(
+          [this](const ros::MessageEvent<dynamic_reconfigure::Config const>& e) { onFormationParameters(e); }));
   diagnostics_.setHardwareID(frame_);
   diagnostics_.add("timed agent", this, &TimedAgentNode::diagnose);
   for (const std::string& w : scenario.warnings) ROS_WARN("%s: %s", name_.c_str(), w.c_str());

@@ -3,6 +3,7 @@
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/Twist.h>
 
+#include "variational_formation/core/validation.hpp"
 #include "variational_formation/ros/participants.hpp"
 #include "variational_formation/ros/timed_agent_node.hpp"
 
@@ -42,6 +43,7 @@ void TimedAgentNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
     status.add("robot lag + tick [s]", lagCheck_.lagPlusTick);
     status.add("delay margin [s]", lagCheck_.capped ? -1.0 : lagCheck_.marginSeconds);  // -1: none found
     status.add("lag exceeds the delay margin", lagCheck_.exceeded);
+    status.add("the margin bounds the lag (odometry feedback)", lagCheck_.applies);
     if (link_->settings().kinematics == RobotKinematics::Unicycle) status.add("heading [rad]", link_->heading());
     if (link_->saturatedCommands() > 0 && status.level == diagnostic_msgs::DiagnosticStatus::OK) {
       status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, "cmd_vel saturated at the limits");
@@ -56,14 +58,31 @@ void TimedAgentNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
 }
 
 void TimedAgentNode::onReconfigure(variational_formation::TimedAgentConfig& config, uint32_t) {
-  if (config.kappa == agent_->dampingGain()) return;
-  try {
-    agent_->setDampingGain(config.kappa);
-    ROS_INFO("%s: kappa set to %g at step %ld", name_.c_str(), config.kappa, agent_->step());
-  } catch (const std::exception& e) {
-    ROS_WARN("%s: kappa not changed: %s", name_.c_str(), e.what());
-    config.kappa = agent_->dampingGain();
+  config.kappa = applyDampingGain(config.kappa, "~kappa");
+}
+
+void TimedAgentNode::onFormationParameters(const ros::MessageEvent<dynamic_reconfigure::Config const>& event) {
+  if (!fromOwner(event, monitor_)) {
+    drop("formation parameters from " + event.getPublisherName() + ", which is not the monitor " + monitor_);
+    return;
   }
+  for (const dynamic_reconfigure::DoubleParameter& p : event.getConstMessage()->doubles) {
+    if (p.name != "kappa" || p.value == agent_->dampingGain()) continue;
+    auto config = variational_formation::TimedAgentConfig::__getDefault__();
+    config.kappa = applyDampingGain(p.value, "the formation's kappa");
+    reconfigure_->updateConfig(config);  // this agent's server reports it too (dynparam get)
+  }
+}
+
+double TimedAgentNode::applyDampingGain(double kappa, const std::string& field) {
+  if (kappa == agent_->dampingGain()) return kappa;
+  if (const auto refusal = refuseDampingGain(h_, kappa, agent_->dampingGain(), field)) {
+    ROS_WARN("%s: %s", name_.c_str(), refusal->c_str());
+  } else {
+    agent_->setDampingGain(kappa);
+    ROS_INFO("%s: kappa set to %g from step %ld on (%s)", name_.c_str(), kappa, agent_->step() + 1, field.c_str());
+  }
+  return agent_->dampingGain();
 }
 
 void TimedAgentNode::publish() {

@@ -4,7 +4,6 @@
 #include <geometry_msgs/Twist.h>
 
 #include "variational_formation/core/error.hpp"
-#include "variational_formation/core/number_checks.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/timed_agent_node.hpp"
 
@@ -31,17 +30,11 @@ void TimedAgentNode::setUpRobot(ros::NodeHandle& nh, ros::NodeHandle& pnh, const
   odomSub_ = nh.subscribe(in + "odom", 10, &TimedAgentNode::onOdometry, this, ros::TransportHints().tcpNoDelay());
   setpointPub_ = nh.advertise<geometry_msgs::PoseStamped>(in + "setpoint", 10);
   cmdVelPub_ = nh.advertise<geometry_msgs::Twist>(in + "cmd_vel", 10);
-  lagCheck_ = checkRobotLag(scenario, s.lag, h_ / rate_);
-  const RobotLagCheck& lag = lagCheck_;
-  if (lag.exceeded) {
-    ROS_WARN("%s: %s%s", name_.c_str(), lag.warning.c_str(),
-             s.feedback == RobotFeedback::Integrated
-                 ? " (integrated feedback is on: the formation forms on the agents' own states and the robots track "
-                   "them)"
-                 : "");
+  lagCheck_ = checkRobotLag(scenario, s.lag, h_ / rate_, s.feedback, "~");
+  if (!lagCheck_.warning.empty()) {
+    ROS_WARN("%s: %s", name_.c_str(), lagCheck_.warning.c_str());
   } else {
-    ROS_INFO("%s: robot lag %g s plus one tick %g s is within the delay margin %s", name_.c_str(), s.lag, h_ / rate_,
-             lag.capped ? "(none found up to there)" : (formatNumber(lag.marginSeconds) + " s").c_str());
+    ROS_INFO("%s: %s", name_.c_str(), lagCheck_.info.c_str());
   }
 }
 

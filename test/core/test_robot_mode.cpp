@@ -8,6 +8,7 @@
 #include <string>
 
 #include "variational_formation/core/error.hpp"
+#include "variational_formation/core/number_checks.hpp"
 #include "variational_formation/core/robot_mode.hpp"
 
 namespace vf {
@@ -30,6 +31,47 @@ TEST(RobotLag, WarnsWhenTheLagExceedsTheMargin) {
   EXPECT_TRUE(fast.warning.empty());
   EXPECT_THROW(checkRobotLag(ring, -0.1, 0.01), InvalidInput);
   EXPECT_THROW(checkRobotLag(ring, 0.1, 0.0), InvalidInput);
+}
+
+TEST(RobotLag, LinesNameTheOptionsAndRoundTheirNumbers) {
+  const Scenario ring = loadScenario(kRing);
+  // The sum: 0.1 + 0.02 is 0.12000000000000001 in doubles; the lines print 0.12.
+  ASSERT_EQ(formatNumber(0.1 + 0.02), "0.12000000000000001");
+  const RobotLagCheck odometry = checkRobotLag(ring, 0.1, 0.02, RobotFeedback::Odometry, "~");
+  EXPECT_TRUE(odometry.applies);
+  EXPECT_TRUE(odometry.exceeded);
+  EXPECT_EQ(odometry.warning.rfind("~feedback odometry, ~robot_lag: robot lag 0.1 s plus one tick 0.02 s = 0.12 s "
+                                   "exceeds the delay margin D* = 5 steps = 0.05 s (kappa 2, h 0.01): ",
+                                   0),
+            0u)
+      << odometry.warning;
+  EXPECT_NE(odometry.warning.find("or use ~feedback integrated"), std::string::npos) << odometry.warning;
+  EXPECT_TRUE(odometry.info.empty());
+}
+
+TEST(RobotLag, WithIntegratedFeedbackTheMarginIsOnlyReported) {
+  // The lag reaches the formation only through the correction (doc/robots.md): no warning.
+  const Scenario ring = loadScenario(kRing);
+  const RobotLagCheck integrated = checkRobotLag(ring, 0.1, 0.02, RobotFeedback::Integrated, "~");
+  EXPECT_FALSE(integrated.applies);
+  EXPECT_TRUE(integrated.exceeded);  // the numbers are the same; they do not bound this loop
+  EXPECT_EQ(integrated.marginSteps, 5);
+  EXPECT_TRUE(integrated.warning.empty()) << integrated.warning;
+  EXPECT_EQ(integrated.info.rfind("~feedback integrated: robot lag 0.1 s plus one tick 0.02 s = 0.12 s exceeds "
+                                  "the delay margin D* = 5 steps = 0.05 s (kappa 2, h 0.01); the margin bounds "
+                                  "~robot_lag only with ~feedback odometry",
+                                  0),
+            0u)
+      << integrated.info;
+  EXPECT_NE(integrated.info.find("~correction_time"), std::string::npos);
+  // Within the margin, either feedback: one line to inform (no scan found an instability).
+  const RobotLagCheck within = checkRobotLag(ring, 0.02, 0.01, RobotFeedback::Odometry, "~");
+  EXPECT_TRUE(within.warning.empty());
+  EXPECT_EQ(within.info.rfind("~feedback odometry, ~robot_lag: robot lag 0.02 s plus one tick 0.01 s = 0.03 s is "
+                              "within the delay margin",
+                              0),
+            0u)
+      << within.info;
 }
 
 TEST(RobotLag, CorrectionIsAFirstOrderPull) {

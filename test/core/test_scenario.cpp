@@ -10,6 +10,7 @@
 
 #include "test_support.hpp"
 #include "variational_formation/core/error.hpp"
+#include "variational_formation/core/number_checks.hpp"
 #include "variational_formation/core/run_outcome.hpp"
 #include "variational_formation/core/validation.hpp"
 #include "variational_formation/core/variational_update.hpp"
@@ -272,6 +273,45 @@ TEST(Limits, GainsThatWouldBeDenormal) {
   // 0.5 e^{-708} ~ 1.7e-308.
   expectDynamicsRejected(0.5, 1416.0, {"time_step: too small", "got h = 0.5 with kappa = 1416"});
   expectNormalGains(1.0, 708.0);
+}
+
+TEST(Limits, KappaRangeIsTheExactEdgeOfTheCheck) {
+  for (double h : {1.0, 0.5, 0.02, 0.014, 0.01, 1e-3, 1e-100}) {
+    const double k = maxDampingGain(h);
+    EXPECT_NO_THROW(validateDynamics(h, k)) << "h " << h;
+    EXPECT_THROW(validateDynamics(h, up(k)), InvalidInput) << "h " << h;
+  }
+  // At h = 1 the limit on kappa h governs; at h = 0.02 the gain 2h^2/(1 + e^{kappa h}) underflows
+  // first (kappa h <= ln(2 h^2 / DBL_MIN - 1) ~ 701.3 < 708.4).
+  EXPECT_EQ(maxDampingGain(1.0), limits::kMaxDampingTimeStep);
+  EXPECT_NEAR(maxDampingGain(0.02) * 0.02, std::log(2 * 0.02 * 0.02 / DBL_MIN - 1), 1e-9);
+  EXPECT_THROW(maxDampingGain(0.0), InvalidInput);  // no range without a valid h
+}
+
+TEST(Limits, RefusedKappaNamesTheValueTheRangeAndTheKeptKappa) {
+  for (double h : {1.0, 0.5, 0.02, 0.014, 0.01, 1e-3}) {
+    const double k = maxDampingGain(h);
+    EXPECT_FALSE(refuseDampingGain(h, 0.0, 4.0, "~kappa"));
+    EXPECT_FALSE(refuseDampingGain(h, k, 4.0, "~kappa"));
+    for (double bad : {-5.0, -DBL_MIN, up(k), HUGE_VAL, std::nan("")}) {
+      const auto line = refuseDampingGain(h, bad, 4.0, "~kappa");
+      ASSERT_TRUE(line) << bad;
+      EXPECT_EQ(line->find('\n'), std::string::npos) << *line;
+      EXPECT_NE(line->find(" refused, outside the accepted range [0, "), std::string::npos) << *line;
+      EXPECT_NE(line->find("; kappa stays 4"), std::string::npos) << *line;
+    }
+    // The range's upper end is rounded down: accepted itself, and within 6 digits of the edge.
+    const std::string line = *refuseDampingGain(h, -1.0, 4.0, "~kappa");
+    const std::size_t from = line.find("[0, ") + 4;
+    const double shown = std::stod(line.substr(from, line.find(']') - from));
+    EXPECT_LE(shown, k) << line;
+    EXPECT_GE(shown, k * (1.0 - 1e-5)) << line;
+  }
+  // ln(2 h^2 / DBL_MIN - 1) / h = 35063.276 at h = 0.02 (computed apart, in Python), rounded down.
+  EXPECT_EQ(*refuseDampingGain(0.02, -5.0, 4.0, "~kappa"),
+            "~kappa: -5 refused, outside the accepted range [0, 35063.2] 1/s at time step h = 0.02 s; "
+            "kappa stays 4");
+  EXPECT_EQ(formatRounded(0.1 + 0.02), "0.12");  // not its shortest text 0.12000000000000001
 }
 
 TEST(Limits, Steps) {

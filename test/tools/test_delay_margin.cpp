@@ -76,7 +76,7 @@ TEST(DelayFlags, BadValuesAreOneLine) {
   };
   bad({"--delay-steps", "-1"}, "--delay-steps");
   bad({"--delay-steps", "2.5"}, "--delay-steps: expected an integer");
-  bad({"--loss", "1.5"}, "--loss: must be a probability in [0, 1]");
+  bad({"--loss", "1.5"}, "--loss: must be a probability in [0, 1], got 1.5\n");  // as given, not 1.500000
   bad({"--loss", "-0.1"}, "--loss");
   bad({"--loss", "0.1", "--method", "euler"}, "only with --method vi");
   bad({"--delay-steps", "1", "--method", "rk4"}, "only with --method vi");

@@ -19,7 +19,11 @@ void requireFiniteWithin(const std::string& field, double value, double lower, d
 /// The limits every simulated robot has (robot_sim's parameter names): lag [s] >= 0,
 /// max_speed [m/s] > 0, odometry_noise [m] >= 0, all finite. @throws InvalidInput
 void requireRobotLimits(double lag, double maxSpeed, double odometryNoise);
-/// Shortest decimal text that reads back as the same double ("0.1", "-inf", "nan").
+/// Shortest decimal text that reads back as the same double ("0.1", "-inf", "nan"): a value
+/// as the user gave it, an exact limit, a number a tool reads back.
 std::string formatNumber(double value);
+/// A computed number for a person to read (a sum, a quotient, a derived limit): 6 significant
+/// digits, so 0.1 + 0.02 reads "0.12", not "0.12000000000000001" ("-inf", "nan" as above).
+std::string formatRounded(double value);
 
 }  // namespace vf

@@ -8,24 +8,38 @@
 
 namespace vf {
 
+/// The robots of a closed-loop run.
+enum class RobotKinematics { Holonomic, Unicycle };
+
+/// Where the agents' positions come from: the odometry at every tick, or their own integration
+/// corrected slowly towards the odometry.
+enum class RobotFeedback { Odometry, Integrated };
+
 /// The scenario's delay margin against a robot's lag plus one tick (doc/robots.md).
 struct RobotLagCheck {
   long marginSteps = -1;       ///< D* (predictDelayMargin); -1 if not even D = 0 is stable
   bool capped = false;         ///< no instability found up to the delays that matter
   double marginSeconds = 0.0;  ///< D* h [s]
   double lagPlusTick = 0.0;    ///< lag + tick period [s]
-  bool exceeded = false;       ///< lagPlusTick > marginSeconds
-  std::string warning;         ///< one line if exceeded, else empty
+  bool exceeded = false;       ///< lagPlusTick > marginSeconds, whatever the feedback
+  bool applies = true;         ///< odometry feedback: the margin bounds the lag
+  std::string warning;         ///< one line if it applies and is exceeded, else empty
+  std::string info;            ///< one line otherwise: the numbers, and whether they matter
 };
 
 /**
  * Predicts the delay margin D* of the scenario's formation at its kappa and h and compares D* h
  * with lag + tickPeriod, the staleness a robot's first-order lag adds to the agent's own position
- * in odometry feedback. The robot-mode agent logs `warning` at start.
+ * in odometry feedback. With integrated feedback the lag reaches the formation only through the
+ * slow correction, so the margin does not bound it: the numbers go to `info`, never `warning`.
+ * The robot-mode agent logs `warning` (or `info`) at start. The lines name the options they
+ * concern: robot_lag, feedback and correction_time, after `optionPrefix` ("~" for a node).
+ * Numbers are rounded (formatRounded).
  * @param lag robot lag tau [s] >= 0. @param tickPeriod [s] > 0.
  * @throws InvalidInput on bad numbers or a formation without edges.
  */
-RobotLagCheck checkRobotLag(const Scenario& scenario, double lag, double tickPeriod);
+RobotLagCheck checkRobotLag(const Scenario& scenario, double lag, double tickPeriod,
+                            RobotFeedback feedback = RobotFeedback::Odometry, const std::string& optionPrefix = "");
 
 /**
  * Integrated feedback (doc/robots.md): the position the agent's next tick starts from, its own
@@ -36,13 +50,6 @@ RobotLagCheck checkRobotLag(const Scenario& scenario, double lag, double tickPer
  */
 void correctedPosition(const std::vector<double>& integrated, const std::vector<double>& measured,
                        double timeStep, double correctionTime, std::vector<double>& out);
-
-/// The robots of a closed-loop run.
-enum class RobotKinematics { Holonomic, Unicycle };
-
-/// Where the agents' positions come from: the odometry at every tick, or their own integration
-/// corrected slowly towards the odometry.
-enum class RobotFeedback { Odometry, Integrated };
 
 struct RobotLoopSettings {
   RobotKinematics kinematics = RobotKinematics::Holonomic;

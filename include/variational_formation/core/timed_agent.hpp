@@ -93,7 +93,8 @@ class TimedAgent {
 
   /**
    * kappa [1/s] (dynamic_reconfigure): recomputes the update coefficients; the velocity state
-   * is kept. @throws InvalidInput if kappa is not finite and >= 0.
+   * is kept. @throws InvalidInput if validateDynamics refuses kappa at the scenario's h (as in a
+   * scenario file; refuseDampingGain words the refusal for a node's log).
    */
   void setDampingGain(double dampingGain);
 

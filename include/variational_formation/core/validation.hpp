@@ -46,6 +46,21 @@ struct FieldNames {
  * @throws InvalidInput naming the field, the value and the limit.
  */
 void validateDynamics(double timeStep, double dampingGain, const FieldNames& names = {});
+/// validateDynamics without the throw: the message, or "" if h and kappa are accepted.
+std::string dynamicsProblem(double timeStep, double dampingGain, const FieldNames& names = {});
+
+/// The largest kappa [1/s] that validateDynamics accepts at time step h [s] (the accepted range
+/// is [0, that]), exactly. @throws InvalidInput if h itself is refused.
+double maxDampingGain(double timeStep);
+
+/**
+ * A new kappa [1/s] for a running formation or agent (dynamic_reconfigure), checked by
+ * validateDynamics at the run's h [s]. @return nothing if `requested` is accepted; else one line
+ * for a warning: `field`, the value given, the accepted range [0, maxDampingGain] and that
+ * `current` is kept.
+ */
+std::optional<std::string> refuseDampingGain(double timeStep, double requested, double current,
+                                             const std::string& field);
 
 /// Checks a step count: 0 <= steps <= limits::kMaxSteps, and steps >= 1 if requireBounded
 /// (0 = unbounded is only for the ROS run). @throws InvalidInput naming `field`.

@@ -6,12 +6,14 @@
 #include <utility>
 #include <vector>
 
+#include <dynamic_reconfigure/server.h>
 #include <geometry_msgs/Twist.h>
 #include <ros/ros.h>
 #include <std_msgs/Float64.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include "variational_formation/AgentState.h"
+#include "variational_formation/FormationConfig.h"
 #include "variational_formation/FormationStatus.h"
 #include "variational_formation/RecallHistory.h"
 #include "variational_formation/RecallState.h"
@@ -103,6 +105,12 @@ class MonitorNode {
   /// The issued list on `command`, stamped as the mode stamps what it says (stampOf).
   void publishCommands();
 
+  // The formation's kappa (src/ros/monitor_parameters.cpp, doc/ros_api.md "monitor"): a
+  // dynamic_reconfigure server in the formation's namespace, whose latched parameter_updates the
+  // timed agents follow. Lockstep (`timed` false) refuses any change.
+  void setUpParameters(ros::NodeHandle& nh, bool timed);
+  void onReconfigure(variational_formation::FormationConfig& config, uint32_t level);
+
   /// Publishes one completed step's status and markers (and /clock), stamped `stamp`; tracks the
   /// congruent stretch for the result. @return what was published, for the recorder gate.
   Published publishSnapshot(const FormationSnapshot& s, const ros::Time& stamp, double dataAge, bool noetherHolds);
@@ -142,6 +150,10 @@ class MonitorNode {
   ros::Subscriber velocityCommandSub_, scaleCommandSub_;
   ros::Publisher commandPub_;
   std::vector<std::string> commanders_;  // full node names; empty: anyone
+  std::unique_ptr<dynamic_reconfigure::Server<variational_formation::FormationConfig>> reconfigure_;
+  double kappa_ = 0.0;       // the formation's kappa [1/s]
+  bool kappaFixed_ = false;  // lockstep: the scenario's, for good
+  std::string kappaName_;    // its parameter, resolved (/formation/kappa)
 
  private:
   void writeResult(const std::string& result, const std::string& reason) const;

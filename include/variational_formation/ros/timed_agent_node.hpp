@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <diagnostic_updater/diagnostic_updater.h>
+#include <dynamic_reconfigure/Config.h>
 #include <dynamic_reconfigure/server.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
@@ -48,7 +49,10 @@ using variational_formation::RunProgress;
  * accepted and dropped states, injected losses, held ticks; WARN while holding.
  *
  * dynamic_reconfigure (`rosrun dynamic_reconfigure dynparam set /formation/agent_0 kappa 6`): kappa,
- * starting from the scenario's; lockstep keeps it fixed, so that it stays bit for bit exact.
+ * starting from the scenario's; lockstep keeps it fixed, so that it stays bit for bit exact. It
+ * also follows the formation's kappa, served by the monitor in its namespace (`dynparam set
+ * /formation kappa 6`), from that server's latched parameter_updates. A value the scenario's
+ * check refuses is warned about and the old kappa is kept and reported back.
  *
  * Topics, services and private parameters: doc/ros_api.md, "agent (timed mode)".
  */
@@ -80,6 +84,11 @@ class TimedAgentNode {
   double now() const { return ros::WallTime::now().toSec(); }
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
   void onReconfigure(variational_formation::TimedAgentConfig& config, uint32_t level);
+  /// The formation's parameters (the monitor's dynamic_reconfigure server): its kappa applies here.
+  void onFormationParameters(const ros::MessageEvent<dynamic_reconfigure::Config const>& event);
+  /// A new kappa [1/s] named `field`, from the next tick; refused with a WARN by core's check.
+  /// @return the kappa in force.
+  double applyDampingGain(double kappa, const std::string& field);
 
   ros::NodeHandle nh_;
   std::unique_ptr<TimedAgent> agent_;
@@ -88,7 +97,7 @@ class TimedAgentNode {
   std::vector<ros::Subscriber> subs_;
   std::vector<std::string> neighbourOwners_;  // full node names, indexed like neighbourIds()
   std::map<int, AgentState> newest_;          // each neighbour's newest accepted state, for ~recall
-  ros::Subscriber progressSub_, odomSub_, commandSub_;
+  ros::Subscriber progressSub_, odomSub_, commandSub_, formationParametersSub_;
   std::size_t commandsSeen_ = 0;
   ros::ServiceServer recallServer_;
   std::string monitor_;
