@@ -3,6 +3,8 @@
 add_library(variational_formation_tools
   src/tools/arguments.cpp
   src/tools/simulate_cli.cpp
+  src/tools/scenario_info_cli.cpp
+  src/tools/assign_slots_cli.cpp
 )
 target_link_libraries(variational_formation_tools PUBLIC variational_formation_core)
 # Scenario names (--scenario hexagon) are looked up without ROS too, beside the running program
@@ -23,9 +25,16 @@ target_link_libraries(scenario_info variational_formation_tools)
 target_compile_options(scenario_info PRIVATE ${VF_FLAGS})
 install(TARGETS scenario_info RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
+# assign_slots: which robot takes which desired position, from their current positions.
+add_executable(assign_slots src/tools/assign_slots_main.cpp)
+target_link_libraries(assign_slots variational_formation_tools)
+target_compile_options(assign_slots PRIVATE ${VF_FLAGS})
+install(TARGETS assign_slots RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+
 # make_scenario: generated rigid formations (grids, rings, lattices, Henneberg) of any size.
 target_sources(variational_formation_tools PRIVATE
   src/tools/formation_generators.cpp
+  src/tools/globally_rigid_graph.cpp
   src/tools/make_scenario_cli.cpp
 )
 add_executable(make_scenario src/tools/make_scenario_main.cpp)
@@ -37,6 +46,11 @@ if(CATKIN_ENABLE_TESTING)
   target_link_libraries(test_make_scenario variational_formation_tools gtest_main)
   target_compile_options(test_make_scenario PRIVATE ${VF_FLAGS})
   target_compile_definitions(test_make_scenario PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  # scenario_info's rigidity lines, make_scenario --graph and assign_slots.
+  catkin_add_gtest(test_shape_tools test/tools/test_shape_tools.cpp)
+  target_link_libraries(test_shape_tools variational_formation_tools gtest_main)
+  target_compile_options(test_shape_tools PRIVATE ${VF_FLAGS})
+  target_compile_definitions(test_shape_tools PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   catkin_add_gtest(test_scenario_path test/tools/test_scenario_path.cpp)
   target_link_libraries(test_scenario_path variational_formation_tools gtest_main)
   target_compile_options(test_scenario_path PRIVATE ${VF_FLAGS})
