@@ -31,6 +31,11 @@ add_library(variational_formation_core
   src/core/manoeuvre_integrator.cpp
   src/core/tracking.cpp
   src/core/run_outcome.cpp
+  src/core/rigidity.cpp
+  src/core/procrustes.cpp
+  src/core/hungarian.cpp
+  src/core/slot_assignment.cpp
+  src/core/shape_outcome.cpp
   src/core/protocol/recovery.cpp
   src/core/protocol/command_desk.cpp
 )

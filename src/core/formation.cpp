@@ -214,8 +214,8 @@ double Formation::congruenceSlack(const Positions& q, double tolerance, double s
   double slack = std::numeric_limits<double>::infinity();
   for (int i = 0; i < n; ++i) {
     for (int j = i + 1; j < n; ++j) {
-      const double desired = scale * (desiredShape_.col(i) - desiredShape_.col(j)).norm();
-      const double error = std::abs((q.col(i) - q.col(j)).norm() - desired);
+      double desired = 0.0;
+      const double error = pairError(q, i, j, scale, desired);
       // Negative exactly when error > tolerance * desired (two distinct doubles never differ
       // by 0), NaN when either is NaN: the first such pair ends the test.
       const double pair = tolerance * desired - error;
@@ -224,6 +224,26 @@ double Formation::congruenceSlack(const Positions& q, double tolerance, double s
     }
   }
   return slack;
+}
+
+double Formation::shapeError(const Positions& q, double scale) const {
+  double worst = 0.0, desired = 0.0;
+  for (int i = 0; i < agentCount(); ++i) {
+    for (int j = i + 1; j < agentCount(); ++j) {
+      const double error = pairError(q, i, j, scale, desired);
+      if (std::isnan(error)) return error;  // NaN positions: NaN, not a small error
+      worst = std::max(worst, error);
+    }
+  }
+  return worst;
+}
+
+bool Formation::edgesWithin(const Positions& q, double tolerance, double scale) const {
+  const Eigen::VectorXd errors = distanceErrors(q, scale);
+  for (std::size_t e = 0; e < edges_.size(); ++e) {
+    if (!(std::abs(errors(static_cast<Eigen::Index>(e))) <= tolerance * scale * edges_[e].desiredDistance)) return false;
+  }
+  return true;
 }
 
 bool Formation::isCongruent(const Positions& q, const Velocities& v, double tolerance,

@@ -48,6 +48,15 @@ long toInteger(const YAML::Node& node, const std::string& field) {
   return value;
 }
 
+/// An optional two-valued field: true for `yes`, false for `no` or when absent.
+bool choice(const YAML::Node& map, const std::string& key, const std::string& yes, const std::string& no) {
+  const YAML::Node node = map[key];
+  if (!node.IsDefined() || node.IsNull()) return false;
+  const std::string value = node.IsScalar() ? node.Scalar() : "";
+  if (value != yes && value != no) throw InvalidInput(key + ": expected " + yes + " or " + no + ", got " + describe(node));
+  return value == yes;
+}
+
 void rejectUnknownKeys(const YAML::Node& map, const std::set<std::string>& known,
                        const std::string& field) {
   for (const auto& kv : map) {
@@ -119,7 +128,7 @@ Scenario parseRoot(const YAML::Node& root) {
   if (!root.IsMap()) throw InvalidInput("scenario: expected a YAML mapping at the top level");
   rejectUnknownKeys(root,
                     {"name", "dimension", "kappa", "time_step", "steps", "agents", "edges", "manoeuvre",
-                     "require_convergence"},
+                     "require_convergence", "mirror", "assignment"},
                     "");
   Scenario s;
   const YAML::Node name = required(root, "name", "name");
@@ -144,6 +153,9 @@ Scenario parseRoot(const YAML::Node& root) {
       throw InvalidInput("require_convergence: expected true or false, got " + describe(r));
     }
   }
+
+  s.mirrorAllowed = choice(root, "mirror", "allowed", "forbidden");
+  s.autoAssignment = choice(root, "assignment", "auto", "none");
 
   const YAML::Node agents = required(root, "agents", "agents");
   if (!agents.IsSequence() || agents.size() == 0) {
@@ -209,6 +221,10 @@ Scenario parseScenario(const std::string& yamlText, const std::string& source) {
   try {
     Scenario s = parseRoot(YAML::Load(yamlText));
     validateScenario(s);
+    if (s.autoAssignment) {
+      applySlotAssignment(s);
+      validateScenario(s);  // the warnings of the assigned formation (its start and edges changed)
+    }
     return s;
   } catch (const YAML::Exception& e) {
     std::ostringstream msg;
@@ -220,18 +236,23 @@ Scenario parseScenario(const std::string& yamlText, const std::string& source) {
   }
 }
 
-Scenario loadScenario(const std::string& path) {
+namespace {
+
+/// The whole text of a file; `what` names it in errors ("<path>: cannot open the <what> file").
+std::string readTextFile(const std::string& path, const std::string& what) {
   std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    throw InvalidInput(path + ": is a directory, not a scenario file");
-  }
+  if (std::filesystem::is_directory(path, ec)) throw InvalidInput(path + ": is a directory, not a " + what + " file");
   std::ifstream in(path);
-  if (!in) throw InvalidInput(path + ": cannot open the scenario file");
+  if (!in) throw InvalidInput(path + ": cannot open the " + what + " file");
   std::stringstream text;
   text << in.rdbuf();
-  if (in.bad()) throw InvalidInput(path + ": cannot read the scenario file");
-  return parseScenario(text.str(), path);
+  if (in.bad()) throw InvalidInput(path + ": cannot read the " + what + " file");
+  return text.str();
 }
+
+}  // namespace
+
+Scenario loadScenario(const std::string& path) { return parseScenario(readTextFile(path, "scenario"), path); }
 
 namespace {
 
@@ -302,15 +323,75 @@ CommandSchedule parseCommands(const std::string& text, const std::string& source
   }
 }
 
+Positions parseStartPositions(const std::string& text, const std::string& source, const Scenario& scenario) {
+  std::istringstream in(text);
+  std::string line;
+  long number = 0;
+  const int n = scenario.agentCount();
+  Positions q(scenario.dimension, n);
+  std::vector<bool> seen(static_cast<std::size_t>(n), false);
+  try {
+    if (!std::getline(in, line) || (++number, line) != "agent,x,y,z") {
+      throw InvalidInput("line 1: expected the header 'agent,x,y,z', got '" + line + "'");
+    }
+    while (std::getline(in, line)) {
+      ++number;
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      if (line.empty()) continue;
+      const std::string where = "line " + std::to_string(number);
+      const std::vector<std::string> fields = splitFields(line);
+      if (fields.size() != 4) throw InvalidInput(where + ": expected 4 columns (agent,x,y,z), got " + std::to_string(fields.size()));
+      const long id = parseField<long>(fields[0], where + ": agent");
+      if (id < 0 || id >= n) {
+        throw InvalidInput(where + ": agent: " + std::to_string(id) + " is not in the scenario (ids 0.." + std::to_string(n - 1) + ")");
+      }
+      if (seen[static_cast<std::size_t>(id)]) throw InvalidInput(where + ": agent: " + std::to_string(id) + " given twice");
+      seen[static_cast<std::size_t>(id)] = true;
+      static const char* const kAxes[] = {"x", "y", "z"};
+      for (int a = 0; a < 3; ++a) {
+        const double x = parseField<double>(fields[a + 1], where + ": " + kAxes[a]);
+        if (!std::isfinite(x)) throw InvalidInput(where + ": " + kAxes[a] + ": must be finite, got " + fields[a + 1]);
+        if (a < scenario.dimension) {
+          q(a, id) = x;
+        } else if (x != 0.0) {
+          throw InvalidInput(where + ": z: must be 0 in a 2D scenario, got " + fields[3]);
+        }
+      }
+    }
+    for (int i = 0; i < n; ++i) {
+      if (!seen[static_cast<std::size_t>(i)]) throw InvalidInput("agent " + std::to_string(i) + ": no row (every agent needs one)");
+    }
+    return q;
+  } catch (const InvalidInput& e) {
+    throw InvalidInput(source + ": " + e.what());
+  }
+}
+
+Positions loadStartPositions(const std::string& path, const Scenario& scenario) {
+  return parseStartPositions(readTextFile(path, "start positions"), path, scenario);
+}
+
 CommandSchedule loadCommands(const std::string& path, const Scenario& scenario) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw InvalidInput(path + ": is a directory, not a commands file");
-  std::ifstream in(path);
-  if (!in) throw InvalidInput(path + ": cannot open the commands file");
-  std::stringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw InvalidInput(path + ": cannot read the commands file");
-  return parseCommands(text.str(), path, scenario);
+  return parseCommands(readTextFile(path, "commands"), path, scenario);
+}
+
+void applySlotAssignment(Scenario& s) {
+  const int n = s.agentCount();
+  if (n > kMaxAssignedAgents) {
+    throw InvalidInput("assignment: auto is for at most " + std::to_string(kMaxAssignedAgents) +
+                       " agents (every agent runs the O(n^3) Hungarian method at start-up), got " + std::to_string(n) +
+                       "; run assign_slots once and launch its output");
+  }
+  s.assignment = assignSlots(s.initialPositions, s.desiredPositions, s.mirrorAllowed);
+  const std::vector<int>& slot = s.assignment.slotOfAgent;
+  std::vector<int> agentOf(static_cast<std::size_t>(n));
+  const Positions slots = s.desiredPositions;
+  for (int i = 0; i < n; ++i) {
+    s.desiredPositions.col(i) = slots.col(slot[i]);
+    agentOf[static_cast<std::size_t>(slot[i])] = i;
+  }
+  // Edges join slots: the agents that took slots a and b are linked.
+  for (auto& e : s.edges) e = {agentOf[static_cast<std::size_t>(e.first)], agentOf[static_cast<std::size_t>(e.second)]};
 }
 
 Formation makeFormation(const Scenario& s) {

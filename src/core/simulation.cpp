@@ -24,6 +24,7 @@ StepMetrics measure(const Integrator& integrator) {
   m.centroidVelocity = centroidVelocity(v);
   m.rotationRate = rotationRate(integrator.positions(), v, integrator.timeStep());
   m.scaleError = meanScaleError(integrator.formation(), integrator.positions(), scale);
+  m.shapeError = integrator.formation().shapeError(integrator.positions(), scale);
   return m;
 }
 
@@ -78,7 +79,7 @@ void writeTrajectoryRows(std::ostream& out, long step, double time, const Positi
 }
 
 void writeMetricsHeader(std::ostream& out) {
-  out << "step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error\n";
+  out << "step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error,shape_error\n";
 }
 
 void writeMetricsRow(std::ostream& out, const StepMetrics& m) {
@@ -97,8 +98,10 @@ void writeMetricsRow(std::ostream& out, const StepMetrics& m) {
       put(out, (*x)(a));
     }
   }
-  out << ',';
-  put(out, m.scaleError);
+  for (double x : {m.scaleError, m.shapeError}) {
+    out << ',';
+    put(out, x);
+  }
   out << '\n';
 }
 

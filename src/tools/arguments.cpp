@@ -3,9 +3,11 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <limits>
 
 #include "variational_formation/core/error.hpp"
+#include "variational_formation/tools/simulate_cli.hpp"
 
 namespace vf {
 
@@ -84,6 +86,23 @@ ScenarioOverrides scenarioOverrides(const Arguments& args) {
                                    std::numeric_limits<long>::max());
   }
   return overrides;
+}
+
+int writeOutput(const Arguments& args, const std::string& text, const std::string& tool, std::ostream& out,
+                std::ostream& err) {
+  if (!args.has("--out")) {
+    out << text;
+    return kExitOk;
+  }
+  std::ofstream file(args.text("--out"));
+  if (!file) throw InvalidInput("--out: cannot write '" + args.text("--out") + "'");
+  file << text;
+  file.flush();
+  if (!file) {
+    err << tool << ": error: writing '" << args.text("--out") << "' failed (disk full?)\n";
+    return kExitFailure;
+  }
+  return kExitOk;
 }
 
 }  // namespace vf

@@ -6,6 +6,8 @@
 
 #include "variational_formation/core/delayed_integrator.hpp"
 #include "variational_formation/core/error.hpp"
+#include "variational_formation/core/shape_outcome.hpp"
+#include "variational_formation/core/tracking.hpp"
 #include "variational_formation/core/simulation.hpp"
 #include "variational_formation/tools/arguments.hpp"
 #include "variational_formation/tools/scenario_path.hpp"
@@ -21,12 +23,16 @@ const char* kUsage =
     "                [--delay-steps D] [--loss P [--seed S]]   (vi only)\n"
     "                [--commands FILE.csv]   (vi only; replaces the scenario's manoeuvre)\n"
     "Runs a formation scenario centrally. traj.csv: step,t,agent,x,y,z;\n"
-    "metrics.csv: step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error.\n"
+    "metrics.csv: step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error,\n"
+    "shape_error. The last line on stdout says how the formation ended: 'formation: converged to the\n"
+    "desired shape ...', 'formation: edges converged but the shape is not the desired one ...' or\n"
+    "'formation: not converged ...'; with `assignment: auto` a line 'assignment: ...' comes first.\n"
     "--commands: rows step,vx,vy,vz,wx,wy,wz,scale, each applying from its step on\n"
     "(doc/manoeuvres.md).\n"
     "Flags override the scenario file. --delay-steps D: each agent uses its neighbours'\n"
     "q_j^{k-D}; --loss P: each neighbour state is lost with probability P (seed S, default 1).\n"
-    "Exit status 2 on bad input, 1 if the run diverges.\n";
+    "Exit status 2 on bad input, 1 if the run diverges, or if the scenario has\n"
+    "require_convergence: true and the formation did not reach the desired shape.\n";
 
 std::ofstream openOutput(const std::string& flag, const std::string& path) {
   std::ofstream out(path);
@@ -97,6 +103,7 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
                                         : scheduleFromSegments(scenario.manoeuvre, scenario.timeStep);
     }
     for (const std::string& w : scenario.warnings) err << "simulate: warning: " << w << '\n';
+    if (scenario.autoAssignment) out << "assignment: " << scenario.assignment.describe() << '\n';
 
     std::ofstream traj = openOutput("--out", args.text("--out"));
     std::ofstream metrics;
@@ -105,7 +112,13 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
     writeTrajectoryHeader(traj);
     if (withMetrics) writeMetricsHeader(metrics);
     long divergedAt = -1;
+    const Formation formation = makeFormation(scenario);
+    ShapeTracker shape(formation, scenario.mirrorAllowed);
     const auto observe = [&](const Integrator& integrator) {
+      const long k = integrator.stepIndex();
+      Velocities v = integrator.velocities();
+      if (manoeuvre) subtractCommandedMotion(schedule.at(k > 0 ? k - 1 : 0), integrator.positions(), v);
+      shape.observe(k, integrator.positions(), v, integrator.commandedScale());
       writeTrajectoryRows(traj, integrator.stepIndex(), integrator.time(),
                           integrator.positions());
       if (withMetrics) writeMetricsRow(metrics, measure(integrator));
@@ -129,6 +142,13 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
     if (divergedAt >= 0) {
       err << "simulate: error: the run diverged: non-finite positions from step " << divergedAt
           << " (try a smaller --time-step)\n";
+      return kExitFailure;
+    }
+    const ShapeOutcome outcome = shape.outcome(scenario.timeStep);
+    out << "formation: " << outcome.line << '\n';
+    if (scenario.requireConvergence && outcome.verdict != ShapeVerdict::DesiredShape) {
+      err << "simulate: error: the formation did not reach the desired shape, and the scenario requires it "
+             "(require_convergence: true)\n";
       return kExitFailure;
     }
     return kExitOk;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "variational_formation/tools/simulate_cli.hpp"
@@ -22,14 +23,18 @@ struct CliResult {
   std::string err;
 };
 
-inline CliResult simulate(std::vector<std::string> args) {
-  args.insert(args.begin(), "simulate");
+/// Any of the tools' run*Cli functions, in-process, with `args` after the program name.
+inline CliResult runCli(int (*cli)(int, const char* const*, std::ostream&, std::ostream&), std::vector<std::string> args,
+                        const std::string& program = "tool") {
+  args.insert(args.begin(), program);
   std::vector<const char*> argv;
   for (const auto& a : args) argv.push_back(a.c_str());
   std::ostringstream out, err;
-  const int status = runSimulateCli(static_cast<int>(argv.size()), argv.data(), out, err);
+  const int status = cli(static_cast<int>(argv.size()), argv.data(), out, err);
   return {status, out.str(), err.str()};
 }
+
+inline CliResult simulate(std::vector<std::string> args) { return runCli(runSimulateCli, std::move(args), "simulate"); }
 
 /// Exit status 2 and exactly one line "simulate: error: ..." containing `fragment`.
 inline void expectBadInput(const std::vector<std::string>& args, const std::string& fragment) {

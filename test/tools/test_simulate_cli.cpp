@@ -58,7 +58,7 @@ TEST(SimulateCli, WritesTrajectoryAndMetricsThatRoundTripTheLibrarysRun) {
   ASSERT_EQ(t.size(), 1u + 21u * 4u);
   ASSERT_EQ(m.size(), 22u);
   EXPECT_EQ(t[0], "step,t,agent,x,y,z");
-  EXPECT_EQ(m[0], "step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error");
+  EXPECT_EQ(m[0], "step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error,shape_error");
 
   // The same run through the library: every written number must read back as the very double
   // the library computed (17 significant digits round-trip), z = 0 in 2D.
@@ -68,7 +68,7 @@ TEST(SimulateCli, WritesTrajectoryAndMetricsThatRoundTripTheLibrarysRun) {
   runScenario(scenario, Method::Variational, StartMethod::Variational, [&](const Integrator& integ) {
     const StepMetrics expected = measure(integ);
     const std::vector<double> mv = numbers(m[static_cast<std::size_t>(integ.stepIndex()) + 1]);
-    ASSERT_EQ(mv.size(), 17u);
+    ASSERT_EQ(mv.size(), 18u);
     const double metricValues[] = {static_cast<double>(expected.step), expected.time, expected.energy,
                                    expected.maxDistanceError,         expected.linearMomentum(0),
                                    expected.linearMomentum(1),        expected.linearMomentum(2),
@@ -76,8 +76,9 @@ TEST(SimulateCli, WritesTrajectoryAndMetricsThatRoundTripTheLibrarysRun) {
                                    expected.angularMomentum(2),       expected.centroidVelocity(0),
                                    expected.centroidVelocity(1),      expected.centroidVelocity(2),
                                    expected.rotationRate(0),          expected.rotationRate(1),
-                                   expected.rotationRate(2),          expected.scaleError};
-    for (int c = 0; c < 17; ++c) EXPECT_EQ(mv[c], metricValues[c]) << "metrics step " << expected.step << " column " << c;
+                                   expected.rotationRate(2),          expected.scaleError,
+                                   expected.shapeError};
+    for (int c = 0; c < 18; ++c) EXPECT_EQ(mv[c], metricValues[c]) << "metrics step " << expected.step << " column " << c;
     for (int i = 0; i < 4; ++i, ++row) {
       const std::vector<double> tv = numbers(t[row]);
       ASSERT_EQ(tv.size(), 6u);

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cmath>
 #include <utility>
 #include <vector>
 
@@ -95,8 +96,21 @@ class Formation {
   /// s a commanded scale (>= 0 iff every pair is within tolerance; +inf with fewer than two agents).
   /// It stops at the first pair outside, and returns that pair's negative (or NaN) value.
   double congruenceSlack(const Positions& q, double tolerance, double scale = 1.0) const;
+  /// Shape error: max over all pairs, not only the edges, of | |q_i - q_j| - s |q*_i - q*_j| | [m]
+  /// (0 with fewer than two agents). A folded realization with every edge right has a large
+  /// one; a mirror image has none (doc/scenarios.md, "Mirror images"). O(n^2).
+  double shapeError(const Positions& q, double scale = 1.0) const;
+  /// Every edge within `tolerance` (relative) of s d_ij: the edge part of congruence.
+  bool edgesWithin(const Positions& q, double tolerance, double scale = 1.0) const;
 
  private:
+  /// | |q_i - q_j| - desired | with desired = s |q*_i - q*_j| [m]: the one pair comparison of
+  /// congruenceSlack and shapeError.
+  double pairError(const Positions& q, int i, int j, double scale, double& desired) const {
+    desired = scale * (desiredShape_.col(i) - desiredShape_.col(j)).norm();
+    return std::abs((q.col(i) - q.col(j)).norm() - desired);
+  }
+
   int dimension_;
   Positions desiredShape_;
   std::vector<Edge> edges_;

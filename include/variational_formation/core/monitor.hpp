@@ -6,6 +6,7 @@
 
 #include "variational_formation/core/manoeuvre_command.hpp"
 #include "variational_formation/core/scenario.hpp"
+#include "variational_formation/core/shape_outcome.hpp"
 #include "variational_formation/core/simulation.hpp"
 #include "variational_formation/core/variational_update.hpp"
 
@@ -22,6 +23,8 @@ struct FormationSnapshot {
   Positions positions;                 ///< q_k, d x n
   bool converged = false;              ///< congruent (with s d_ij, moving as commanded) at this step
   long convergedStep = -1;             ///< first step of the current congruent stretch
+  /// Shape error over all pairs, edges converged, mirror image (shape_outcome.hpp); O(n^2).
+  ShapeFindings shape;
 };
 
 /**

@@ -6,6 +6,7 @@
 
 #include "variational_formation/core/formation.hpp"
 #include "variational_formation/core/manoeuvre_command.hpp"
+#include "variational_formation/core/slot_assignment.hpp"
 
 namespace vf {
 
@@ -32,6 +33,14 @@ struct Scenario {
   /// Field `require_convergence` (default false): a run whose formation is not congruent with
   /// the desired shape at its end fails (doc/scenarios.md); otherwise it succeeds and says so.
   bool requireConvergence = false;
+  /// Field `mirror` (allowed | forbidden, default forbidden): whether a run that ends in the mirror
+  /// image of the desired shape has reached the desired shape (doc/scenarios.md, "Mirror images").
+  bool mirrorAllowed = false;
+  /// Field `assignment` (auto | none, default none): with auto, loading chose which agent takes which
+  /// desired position (assignSlots), and desiredPositions and edges are the agents' after it.
+  bool autoAssignment = false;
+  /// The assignment made at load (slotOfAgent empty without `assignment: auto`).
+  SlotAssignment assignment;
   /// Non-fatal findings, one line each (a non-rigid desired graph, a too large h).
   std::vector<std::string> warnings;
 
@@ -51,6 +60,26 @@ Scenario parseScenario(const std::string& yamlText, const std::string& source);
 CommandSchedule loadCommands(const std::string& path, const Scenario& scenario);
 /// Parses the text of a commands file; `source` prefixes error messages.
 CommandSchedule parseCommands(const std::string& csvText, const std::string& source, const Scenario& scenario);
+
+/// Largest agent count for `assignment: auto`: every agent runs the O(n^3) Hungarian method at load.
+constexpr int kMaxAssignedAgents = 200;
+
+/**
+ * Slot assignment (doc/scenarios.md): assignSlots from the initial positions to the desired
+ * ones, then agent i takes desired position slotOfAgent[i], and an edge [a, b] of the file,
+ * which joins slots a and b, joins the agents that took them. Edges keep their order.
+ * Sets scenario.assignment. @throws InvalidInput beyond kMaxAssignedAgents agents.
+ */
+void applySlotAssignment(Scenario& scenario);
+
+/**
+ * Reads start positions, a CSV file "agent,x,y,z" with one row per agent of the scenario in any
+ * order (z = 0 in 2D): the robots' current positions for assign_slots.
+ * @throws InvalidInput "<file>: line N: <column>: <problem>".
+ */
+Positions loadStartPositions(const std::string& path, const Scenario& scenario);
+/// Parses the text of a start positions file; `source` prefixes error messages.
+Positions parseStartPositions(const std::string& csvText, const std::string& source, const Scenario& scenario);
 
 /// The formation (desired shape and edges) of a validated scenario.
 Formation makeFormation(const Scenario& scenario);

@@ -21,6 +21,8 @@ struct StepMetrics {
   Vector3 centroidVelocity = Vector3::Zero();
   Vector3 rotationRate = Vector3::Zero();
   double scaleError = 0.0;
+  /// Formation::shapeError against s q*: over all pairs, so a folded shape shows [m]. O(n^2).
+  double shapeError = 0.0;
 };
 
 /// Energy, largest edge distance error (against s d_ij, s the commanded scale), momenta and
@@ -45,7 +47,7 @@ void runManoeuvre(const Scenario& scenario, StartMethod start, const CommandSche
 /// Writes "step,t,agent,x,y,z" (z = 0 in 2D), 17 significant digits.
 void writeTrajectoryHeader(std::ostream& out);
 void writeTrajectoryRows(std::ostream& out, long step, double time, const Positions& q);
-/// Writes "step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error".
+/// Writes "step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error,shape_error".
 void writeMetricsHeader(std::ostream& out);
 void writeMetricsRow(std::ostream& out, const StepMetrics& m);
 

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <iosfwd>
 #include <map>
 #include <string>
 #include <vector>
@@ -38,5 +39,13 @@ class Arguments {
 /// The scenario overrides --time-step H, --kappa K and --steps N that are present, parsed but
 /// not checked: applyOverrides validates them like the file's values.
 ScenarioOverrides scenarioOverrides(const Arguments& args);
+
+/**
+ * Writes `text` to the file --out names, or to `out` without --out. @return kExitOk, or
+ * kExitFailure with "<tool>: error: writing '<file>' failed (disk full?)" on err.
+ * @throws InvalidInput "--out: cannot write '<file>'" if the file cannot be opened.
+ */
+int writeOutput(const Arguments& args, const std::string& text, const std::string& tool, std::ostream& out,
+                std::ostream& err);
 
 }  // namespace vf
