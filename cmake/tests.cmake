@@ -1,7 +1,8 @@
 # gtest unit tests: one file per core concept, run by `catkin_make run_tests`.
 if(CATKIN_ENABLE_TESTING)
   set(VF_CORE_TESTS formation integrators metrics stability scenario free_particle lockstep simulation
-    timed_agent link_faults point_robot unicycle_robot record_ledger layers manoeuvre lockstep_manoeuvre monitor)
+    timed_agent link_faults point_robot unicycle_robot record_ledger layers manoeuvre lockstep_manoeuvre monitor
+    safety_filter spatial_grid safety_scenario blocked_detector)
   foreach(name ${VF_CORE_TESTS})
     catkin_add_gtest(test_${name} test/core/test_${name}.cpp)
     target_link_libraries(test_${name} variational_formation_core gtest_main)
@@ -21,6 +22,10 @@ if(CATKIN_ENABLE_TESTING)
   target_link_libraries(test_simulate_cli variational_formation_tools gtest_main)
   target_compile_options(test_simulate_cli PRIVATE ${VF_FLAGS})
   target_compile_definitions(test_simulate_cli PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  catkin_add_gtest(test_simulate_safety test/tools/test_simulate_safety.cpp)
+  target_link_libraries(test_simulate_safety variational_formation_tools gtest_main)
+  target_compile_options(test_simulate_safety PRIVATE ${VF_FLAGS})
+  target_compile_definitions(test_simulate_safety PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   catkin_add_gtest(test_simulate_manoeuvre test/tools/test_simulate_manoeuvre.cpp)
   target_link_libraries(test_simulate_manoeuvre variational_formation_tools gtest_main)
   target_compile_options(test_simulate_manoeuvre PRIVATE ${VF_FLAGS})

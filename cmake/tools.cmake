@@ -27,6 +27,7 @@ install(TARGETS scenario_info RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATI
 target_sources(variational_formation_tools PRIVATE
   src/tools/formation_generators.cpp
   src/tools/make_scenario_cli.cpp
+  src/tools/deployment.cpp
 )
 add_executable(make_scenario src/tools/make_scenario_main.cpp)
 target_link_libraries(make_scenario variational_formation_tools)

@@ -4,6 +4,7 @@
 
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/metrics.hpp"
+#include "variational_formation/core/tracking.hpp"
 
 namespace vf {
 
@@ -86,25 +87,6 @@ std::vector<FormationSnapshot> FormationMonitor::takeCompleted() {
   }
   return done;
 }
-
-namespace {
-
-/// v_i -= v* + omega* x (q_i - c), c the centroid of q: the velocities in the frame the command
-/// moves (untouched when the command does not move the formation).
-void subtractCommandedMotion(const Command& command, const Positions& q, Velocities& v) {
-  if (command.velocity.isZero(0.0) && !command.rotates()) return;
-  const int d = static_cast<int>(q.rows());
-  Vector3 centroid = Vector3::Zero();
-  centroid.head(d) = q.rowwise().mean();
-  for (Eigen::Index i = 0; i < q.cols(); ++i) {
-    Vector3 r = Vector3::Zero();
-    r.head(d) = q.col(i);
-    const Vector3 u = command.velocity + command.angularRate.cross(r - centroid);
-    v.col(i) -= u.head(d);
-  }
-}
-
-}  // namespace
 
 FormationSnapshot FormationMonitor::measureStep(long step, const Positions& qPrev, const Positions& q) {
   FormationSnapshot s;

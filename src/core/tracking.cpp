@@ -73,4 +73,17 @@ CommandedFrame commandedFrame(const CommandSchedule& schedule, long step, double
   return frame;
 }
 
+void subtractCommandedMotion(const Command& command, const Positions& q, Velocities& v) {
+  if (command.velocity.isZero(0.0) && !command.rotates()) return;
+  const int d = static_cast<int>(q.rows());
+  Vector3 centroid = Vector3::Zero();
+  centroid.head(d) = q.rowwise().mean();
+  for (Eigen::Index i = 0; i < q.cols(); ++i) {
+    Vector3 r = Vector3::Zero();
+    r.head(d) = q.col(i);
+    const Vector3 u = command.velocity + command.angularRate.cross(r - centroid);
+    v.col(i) -= u.head(d);
+  }
+}
+
 }  // namespace vf

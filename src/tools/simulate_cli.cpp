@@ -1,11 +1,14 @@
 #include "variational_formation/tools/simulate_cli.hpp"
 
 #include <cstdint>
+#include <cstdio>
 #include <fstream>
+#include <memory>
 #include <ostream>
 
 #include "variational_formation/core/delayed_integrator.hpp"
 #include "variational_formation/core/error.hpp"
+#include "variational_formation/core/run_tracker.hpp"
 #include "variational_formation/core/simulation.hpp"
 #include "variational_formation/tools/arguments.hpp"
 #include "variational_formation/tools/scenario_path.hpp"
@@ -21,12 +24,15 @@ const char* kUsage =
     "                [--delay-steps D] [--loss P [--seed S]]   (vi only)\n"
     "                [--commands FILE.csv]   (vi only; replaces the scenario's manoeuvre)\n"
     "Runs a formation scenario centrally. traj.csv: step,t,agent,x,y,z;\n"
-    "metrics.csv: step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error.\n"
+    "metrics.csv: step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error\n"
+    "(and min_separation under a scenario's safety: filter).\n"
     "--commands: rows step,vx,vy,vz,wx,wy,wz,scale, each applying from its step on\n"
     "(doc/manoeuvres.md).\n"
     "Flags override the scenario file. --delay-steps D: each agent uses its neighbours'\n"
     "q_j^{k-D}; --loss P: each neighbour state is lost with probability P (seed S, default 1).\n"
-    "Exit status 2 on bad input, 1 if the run diverges.\n";
+    "With safety: or require_convergence: true, the last line says whether and when the\n"
+    "formation converged (a blocked formation ends the run: doc/scenarios.md).\n"
+    "Exit status 2 on bad input, 1 if the run diverges or a required convergence fails.\n";
 
 std::ofstream openOutput(const std::string& flag, const std::string& path) {
   std::ofstream out(path);
@@ -57,6 +63,25 @@ bool parseDelayFlags(const Arguments& args, Method method, DelaySettings& delay)
         args.integer("--seed", 0, std::numeric_limits<long>::max()));
   }
   return true;
+}
+
+/// The last line of a tracked run, and its exit status (finishedRunVerdict).
+int reportOutcome(const RunTracker& tracker, const Scenario& scenario, std::ostream& out, std::ostream& err) {
+  const FormationOutcome formation = tracker.outcome();
+  out << "simulate: formation " << formation.line;
+  if (scenario.safety) {
+    const ClosestPair& c = tracker.closestApproach();
+    char distance[32];
+    std::snprintf(distance, sizeof distance, "%.4g", c.distance);
+    out << "; closest approach " << distance << " m";
+    if (c.first >= 0) out << " (agents " << c.first << ", " << c.second << " at step " << tracker.closestApproachStep() << ")";
+    out << "; filter active in " << tracker.filterActiveSteps() << " steps";
+  }
+  out << '\n';
+  const RunVerdict verdict = finishedRunVerdict(scenario, formation);
+  if (verdict.succeeded) return kExitOk;
+  err << "simulate: error: " << verdict.reason << '\n';
+  return kExitFailure;
 }
 
 }  // namespace
@@ -96,6 +121,8 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
       schedule = args.has("--commands") ? loadCommands(args.text("--commands"), scenario)
                                         : scheduleFromSegments(scenario.manoeuvre, scenario.timeStep);
     }
+    if (scenario.safety && delayed) throw InvalidInput("safety: not with --delay-steps or --loss");
+    checkSafetyMethod(scenario, method);
     for (const std::string& w : scenario.warnings) err << "simulate: warning: " << w << '\n';
 
     std::ofstream traj = openOutput("--out", args.text("--out"));
@@ -103,22 +130,25 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
     const bool withMetrics = args.has("--metrics");
     if (withMetrics) metrics = openOutput("--metrics", args.text("--metrics"));
     writeTrajectoryHeader(traj);
-    if (withMetrics) writeMetricsHeader(metrics);
+    const bool safety = scenario.safety.has_value();
+    if (withMetrics) writeMetricsHeader(metrics, safety);
     long divergedAt = -1;
+    // The outcome is judged only where it matters, so other runs cost what they did.
+    std::unique_ptr<RunTracker> tracker;
+    if (safety || scenario.requireConvergence) tracker = std::make_unique<RunTracker>(scenario, schedule);
     const auto observe = [&](const Integrator& integrator) {
       writeTrajectoryRows(traj, integrator.stepIndex(), integrator.time(),
                           integrator.positions());
-      if (withMetrics) writeMetricsRow(metrics, measure(integrator));
+      if (withMetrics) writeMetricsRow(metrics, measure(integrator), safety);
       if (divergedAt < 0 && !integrator.positions().allFinite()) {
         divergedAt = integrator.stepIndex();
       }
+      return !tracker || tracker->observe(integrator);
     };
-    if (manoeuvre) {
-      runManoeuvre(scenario, start, schedule, observe);
-    } else if (delayed) {
-      runDelayedScenario(scenario, start, delay, observe);
+    if (delayed) {
+      runDelayedScenario(scenario, start, delay, [&](const Integrator& integrator) { observe(integrator); });
     } else {
-      runScenario(scenario, method, start, observe);
+      runCentralised(scenario, method, start, manoeuvre ? &schedule : nullptr, observe);
     }
     traj.flush();
     if (withMetrics) metrics.flush();
@@ -131,7 +161,7 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
           << " (try a smaller --time-step)\n";
       return kExitFailure;
     }
-    return kExitOk;
+    return tracker ? reportOutcome(*tracker, scenario, out, err) : kExitOk;
   } catch (const InvalidInput& e) {
     err << "simulate: error: " << e.what() << '\n';
     return kExitBadInput;

@@ -1,11 +1,13 @@
 #pragma once
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "variational_formation/core/formation.hpp"
 #include "variational_formation/core/manoeuvre_command.hpp"
+#include "variational_formation/core/safety.hpp"
 
 namespace vf {
 
@@ -32,6 +34,10 @@ struct Scenario {
   /// Field `require_convergence` (default false): a run whose formation is not congruent with
   /// the desired shape at its end fails (doc/scenarios.md); otherwise it succeeds and says so.
   bool requireConvergence = false;
+  /// The optional `safety:` block (doc/scenarios.md): every step goes through the safety filter.
+  std::optional<SafetySettings> safety;
+  /// The optional `obstacles:` list (only with `safety:`).
+  std::vector<Obstacle> obstacles;
   /// Non-fatal findings, one line each (a non-rigid desired graph, a too large h).
   std::vector<std::string> warnings;
 

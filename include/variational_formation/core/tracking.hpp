@@ -30,6 +30,10 @@ inline double maxScaledDistanceError(const Formation& formation, const Positions
   return formation.maxDistanceError(q, scale);
 }
 
+/// v_i -= v* + omega* x (q_i - c), c the centroid of q: the velocities in the frame the command
+/// moves (untouched when the command does not move the formation). [m/s]
+void subtractCommandedMotion(const Command& command, const Positions& q, Velocities& v);
+
 /// Where a commanded motion has taken the desired shape by step k (the monitor's ghost).
 struct CommandedFrame {
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  ///< exp(omega*_j h) over intervals j < k, in order
