@@ -36,6 +36,12 @@ add_library(variational_formation_core
   src/core/hungarian.cpp
   src/core/slot_assignment.cpp
   src/core/shape_outcome.cpp
+  src/core/spatial_grid.cpp
+  src/core/safety_filter.cpp
+  src/core/safety_validation.cpp
+  src/core/safety_stage.cpp
+  src/core/blocked_detector.cpp
+  src/core/run_tracker.cpp
   src/core/protocol/recovery.cpp
   src/core/protocol/command_desk.cpp
 )

@@ -27,6 +27,7 @@ target_sources(variational_formation_tools PRIVATE
   src/tools/formation_generators.cpp
   src/tools/globally_rigid_graph.cpp
   src/tools/make_scenario_cli.cpp
+  src/tools/deployment.cpp
 )
 vf_add_tool(make_scenario src/tools/make_scenario_main.cpp)
 vf_add_gtest(test_make_scenario test/tools/test_make_scenario.cpp variational_formation_tools)

@@ -1,6 +1,7 @@
 #include "variational_formation/core/manoeuvre_integrator.hpp"
 
 #include "variational_formation/core/metrics.hpp"
+#include "variational_formation/core/safety_stage.hpp"
 
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/validation.hpp"
@@ -52,6 +53,7 @@ void ManoeuvreIntegrator::step() {
       paperStart(coefficients_, d, q_.col(i).data(), v0_.col(i).data(), next);
     }
   }
+  if (safety_) safety_->apply(q_, step_, qNext_);  // DESIGN.md §7, after every agent's update
   qPrev_.swap(q_);
   q_.swap(qNext_);
   ++step_;

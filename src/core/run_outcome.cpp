@@ -18,10 +18,23 @@ FormationOutcome formationOutcome(long convergedStep, double finalError, double 
   return o;
 }
 
+FormationOutcome blockedOutcome(const std::string& blocked, double finalError) {
+  FormationOutcome o;
+  o.finalError = finalError;
+  o.blocked = blocked;
+  o.line = "not converged (" + blocked + ")";
+  return o;
+}
+
 RunVerdict finishedRunVerdict(const Scenario& scenario, const FormationOutcome& formation) {
   RunVerdict v;
   if (scenario.requireConvergence && !formation.converged) {
     v.succeeded = false;
+    if (!formation.blocked.empty()) {
+      v.reason = "the formation did not converge (" + formation.blocked +
+                 "), and the scenario requires it (require_convergence: true)";
+      return v;
+    }
     char text[200];
     std::snprintf(text, sizeof text,
                   "the formation did not converge (final max distance error %.3g m), and the scenario requires it "

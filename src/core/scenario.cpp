@@ -124,11 +124,51 @@ std::vector<ManoeuvreSegment> parseManoeuvre(const YAML::Node& list, int dimensi
   return segments;
 }
 
+bool given(const YAML::Node& map, const char* key) { return map[key].IsDefined() && !map[key].IsNull(); }
+
+// doc/scenarios.md, "Keeping agents apart"; the numbers are checked by validateSafety.
+SafetySettings parseSafety(const YAML::Node& node) {
+  if (!node.IsMap()) throw InvalidInput("safety: expected a mapping, got " + describe(node));
+  rejectUnknownKeys(node, {"radius", "sensing_radius", "gamma", "max_speed", "blocked_after"}, "safety");
+  SafetySettings s;
+  s.radius = toFiniteDouble(required(node, "radius", "safety.radius"), "safety.radius");
+  s.sensingRadius = toFiniteDouble(required(node, "sensing_radius", "safety.sensing_radius"), "safety.sensing_radius");
+  s.gamma = toFiniteDouble(required(node, "gamma", "safety.gamma"), "safety.gamma");
+  if (given(node, "max_speed")) s.maxSpeed = toFiniteDouble(node["max_speed"], "safety.max_speed");
+  if (given(node, "blocked_after")) s.blockedAfter = toFiniteDouble(node["blocked_after"], "safety.blocked_after");
+  return s;
+}
+
+std::vector<Obstacle> parseObstacles(const YAML::Node& list, int dimension) {
+  if (!list.IsSequence()) throw InvalidInput("obstacles: expected a list, got " + describe(list));
+  std::vector<Obstacle> obstacles;
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const std::string field = "obstacles[" + std::to_string(k) + "]";
+    const YAML::Node node = list[k];
+    if (!node.IsMap()) throw InvalidInput(field + ": expected a mapping, got " + describe(node));
+    rejectUnknownKeys(node, {"center", "radius", "min", "max"}, field);
+    Obstacle o;
+    if (given(node, "center") || given(node, "radius")) {
+      if (given(node, "min") || given(node, "max")) {
+        throw InvalidInput(field + ": either {center, radius} (a disc or ball) or {min, max} (a box), not both");
+      }
+      o.centre.head(dimension) = toVector(required(node, "center", field + ".center"), dimension, field + ".center");
+      o.radius = toFiniteDouble(required(node, "radius", field + ".radius"), field + ".radius");
+    } else {
+      o.shape = Obstacle::Shape::Box;
+      o.min.head(dimension) = toVector(required(node, "min", field + ".min"), dimension, field + ".min");
+      o.max.head(dimension) = toVector(required(node, "max", field + ".max"), dimension, field + ".max");
+    }
+    obstacles.push_back(o);
+  }
+  return obstacles;
+}
+
 Scenario parseRoot(const YAML::Node& root) {
   if (!root.IsMap()) throw InvalidInput("scenario: expected a YAML mapping at the top level");
   rejectUnknownKeys(root,
                     {"name", "dimension", "kappa", "time_step", "steps", "agents", "edges", "manoeuvre",
-                     "require_convergence", "mirror", "assignment"},
+                     "require_convergence", "mirror", "assignment", "safety", "obstacles"},
                     "");
   Scenario s;
   const YAML::Node name = required(root, "name", "name");
@@ -212,6 +252,8 @@ Scenario parseRoot(const YAML::Node& root) {
   }
   const YAML::Node manoeuvre = root["manoeuvre"];
   if (manoeuvre.IsDefined() && !manoeuvre.IsNull()) s.manoeuvre = parseManoeuvre(manoeuvre, s.dimension);
+  if (given(root, "safety")) s.safety = parseSafety(root["safety"]);
+  if (given(root, "obstacles")) s.obstacles = parseObstacles(root["obstacles"], s.dimension);
   return s;
 }
 

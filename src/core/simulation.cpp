@@ -1,11 +1,14 @@
 #include "variational_formation/core/simulation.hpp"
 
 #include <cstdio>
+#include <memory>
 #include <ostream>
 
+#include "variational_formation/core/error.hpp"
 #include "variational_formation/core/validation.hpp"
 #include "variational_formation/core/manoeuvre_integrator.hpp"
 #include "variational_formation/core/metrics.hpp"
+#include "variational_formation/core/safety_stage.hpp"
 #include "variational_formation/core/tracking.hpp"
 
 namespace vf {
@@ -25,34 +28,59 @@ StepMetrics measure(const Integrator& integrator) {
   m.rotationRate = rotationRate(integrator.positions(), v, integrator.timeStep());
   m.scaleError = meanScaleError(integrator.formation(), integrator.positions(), scale);
   m.shapeError = integrator.formation().shapeError(integrator.positions(), scale);
+  if (SafetyStage* safety = integrator.safety()) {
+    m.minSeparation = safety->closestPair(integrator.positions(), integrator.stepIndex()).distance;
+  }
   return m;
+}
+
+std::shared_ptr<SafetyStage> makeSafetyStage(const Scenario& scenario) {
+  if (!scenario.safety) return nullptr;
+  return std::make_shared<SafetyStage>(*scenario.safety, scenario.obstacles, scenario.timeStep);
+}
+
+void checkSafetyMethod(const Scenario& scenario, Method method) {
+  if (scenario.safety && method != Method::Variational) {
+    throw InvalidInput("safety: the filter acts on the variational step; only with --method vi");
+  }
+}
+
+void runCentralised(const Scenario& scenario, Method method, StartMethod start, const CommandSchedule* schedule,
+                    const StepObserver& observe) {
+  validateSteps(scenario.steps, /*requireBounded=*/true);
+  checkSafetyMethod(scenario, method);
+  const Formation formation = makeFormation(scenario);
+  std::unique_ptr<Integrator> integrator;
+  if (schedule) {
+    integrator = std::make_unique<ManoeuvreIntegrator>(formation, scenario.initialPositions,
+                                                       scenario.initialVelocities, scenario.timeStep,
+                                                       scenario.dampingGain, start, *schedule);
+  } else {
+    integrator = makeIntegrator(method, formation, scenario.initialPositions, scenario.initialVelocities,
+                                scenario.timeStep, scenario.dampingGain, start);
+  }
+  integrator->attachSafety(makeSafetyStage(scenario));
+  if (!observe(*integrator)) return;
+  for (long k = 0; k < scenario.steps; ++k) {
+    integrator->step();
+    if (!observe(*integrator)) return;
+  }
 }
 
 void runScenario(const Scenario& scenario, Method method, StartMethod start,
                  const std::function<void(const Integrator&)>& observe) {
-  validateSteps(scenario.steps, /*requireBounded=*/true);
-  const Formation formation = makeFormation(scenario);
-  auto integrator = makeIntegrator(method, formation, scenario.initialPositions,
-                                   scenario.initialVelocities, scenario.timeStep,
-                                   scenario.dampingGain, start);
-  observe(*integrator);
-  for (long k = 0; k < scenario.steps; ++k) {
-    integrator->step();
-    observe(*integrator);
-  }
+  runCentralised(scenario, method, start, nullptr, [&](const Integrator& integrator) {
+    observe(integrator);
+    return true;
+  });
 }
 
 void runManoeuvre(const Scenario& scenario, StartMethod start, const CommandSchedule& schedule,
                   const std::function<void(const Integrator&)>& observe) {
-  validateSteps(scenario.steps, /*requireBounded=*/true);
-  const Formation formation = makeFormation(scenario);
-  ManoeuvreIntegrator integrator(formation, scenario.initialPositions, scenario.initialVelocities,
-                                 scenario.timeStep, scenario.dampingGain, start, schedule);
-  observe(integrator);
-  for (long k = 0; k < scenario.steps; ++k) {
-    integrator.step();
+  runCentralised(scenario, Method::Variational, start, &schedule, [&](const Integrator& integrator) {
     observe(integrator);
-  }
+    return true;
+  });
 }
 
 namespace {
@@ -78,11 +106,12 @@ void writeTrajectoryRows(std::ostream& out, long step, double time, const Positi
   }
 }
 
-void writeMetricsHeader(std::ostream& out) {
-  out << "step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error,shape_error\n";
+void writeMetricsHeader(std::ostream& out, bool withSeparation) {
+  out << "step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error,shape_error"
+      << (withSeparation ? ",min_separation\n" : "\n");
 }
 
-void writeMetricsRow(std::ostream& out, const StepMetrics& m) {
+void writeMetricsRow(std::ostream& out, const StepMetrics& m, bool withSeparation) {
   out << m.step;
   for (double x : {m.time, m.energy, m.maxDistanceError}) {
     out << ',';
@@ -101,6 +130,10 @@ void writeMetricsRow(std::ostream& out, const StepMetrics& m) {
   for (double x : {m.scaleError, m.shapeError}) {
     out << ',';
     put(out, x);
+  }
+  if (withSeparation) {
+    out << ',';
+    put(out, m.minSeparation);
   }
   out << '\n';
 }

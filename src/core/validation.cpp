@@ -170,6 +170,7 @@ void validateScenario(Scenario& s, bool requireBoundedSteps, const FieldNames& n
       adviseTimeStep(formation, s.initialPositions, s.timeStep, s.dampingGain, names.timeStep);
   if (advice.exceeded) s.warnings.push_back(advice.message);
   validateManoeuvre(s, formation, names);
+  validateSafety(s);
 }
 
 CommandFieldNames CommandFieldNames::keys(const std::string& prefix) {

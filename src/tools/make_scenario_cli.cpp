@@ -13,6 +13,7 @@
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/stability.hpp"
 #include "variational_formation/tools/arguments.hpp"
+#include "variational_formation/tools/deployment.hpp"
 #include "variational_formation/tools/formation_generators.hpp"
 #include "variational_formation/tools/globally_rigid_graph.hpp"
 #include "variational_formation/tools/simulate_cli.hpp"
@@ -28,9 +29,12 @@ const char* kUsage =
     "       make_scenario --shape henneberg --agents N --dimension 2|3 [--seed S]\n"
     "   common: [--spacing S] [--perturb SIGMA] [--seed S] [--kappa K] [--time-step H]\n"
     "           [--steps N] [--name NAME] [--out FILE] [--graph complete|knn[:K]]\n"
+    "           [--scatter SIDE [--min-gap G]] [--safety r R GAMMA [--max-speed V]]\n"
     "Writes a rigid formation scenario (YAML, stdout without --out). Desired neighbours are\n"
     "--spacing apart (default 1 m). The start is the desired position plus, per coordinate,\n"
     "uniform noise on [-SIGMA, SIGMA] (default 0.1 * spacing) drawn from --seed (default 1).\n"
+    "--scatter: starts uniform in a square (cube) of side SIDE round the desired centroid, at\n"
+    "least G apart (default r of --safety, else 0); --safety adds a safety: block (doc/scenarios.md).\n"
     "Defaults: kappa 2, h 0.005 s (refused if not below the linear stability limit), 4000 steps.\n"
     "A graph that is not infinitesimally rigid is refused. --graph replaces the shape's edges by a\n"
     "globally rigid graph: every pair, or each agent's K nearest (K >= d + 1, default d + 1), K grown\n"
@@ -180,6 +184,7 @@ void writeScenarioYaml(const Scenario& s, const std::vector<std::string>& commen
         << s.edges[e].second << ']';
   }
   out << "]\n";
+  writeSafetyYaml(s, out);
   out.precision(oldPrecision);
 }
 
@@ -189,7 +194,8 @@ int runMakeScenarioCli(int argc, const char* const* argv, std::ostream& out, std
                          {{"--shape", 1}, {"--rows", 1}, {"--cols", 1}, {"--layers", 1},
                           {"--agents", 1}, {"--chords", 1}, {"--dimension", 1}, {"--spacing", 1},
                           {"--perturb", 1}, {"--seed", 1}, {"--kappa", 1}, {"--time-step", 1},
-                          {"--steps", 1}, {"--name", 1}, {"--out", 1}, {"--graph", 1}, {"--help", 0}, {"-h", 0}});
+                          {"--steps", 1}, {"--name", 1}, {"--out", 1}, {"--graph", 1},
+                          {"--scatter", 1}, {"--min-gap", 1}, {"--safety", 3}, {"--max-speed", 1}, {"--help", 0}, {"-h", 0}});
     if (args.has("--help") || args.has("-h")) {
       out << kUsage;
       return kExitOk;
@@ -234,6 +240,7 @@ int runMakeScenarioCli(int argc, const char* const* argv, std::ostream& out, std
     } else if (s.agentCount() <= kMaxClassifiedAgents) {
       graphComment = "graph: " + classifyRigidity(makeFormation(s)).summary();
     }
+    const std::string scattered = applyDeploymentFlags(args, seed, s);  // --scatter, --safety
 
     // The core's rank test, run once (an SVD: seconds at a few hundred agents). Every shape
     // has n >= d + 1 agents, where rigidity is rank R = dn - d(d+1)/2.
@@ -254,8 +261,9 @@ int runMakeScenarioCli(int argc, const char* const* argv, std::ostream& out, std
                            std::to_string(s.agentCount()) + " agents, " +
                            std::to_string(s.edges.size()) + " edges, infinitesimally rigid (rank " +
                            std::to_string(rank) + ")" + (minimal ? ", minimally rigid" : ""),
-                       "start: desired + uniform noise on [-" + number(sigma) + ", " +
-                           number(sigma) + "] per coordinate, seed " + std::to_string(seed)};
+                       !scattered.empty() ? scattered
+                                          : "start: desired + uniform noise on [-" + number(sigma) + ", " +
+                                                number(sigma) + "] per coordinate, seed " + std::to_string(seed)};
     if (!graphComment.empty()) comments.push_back(graphComment);
     writeScenarioYaml(s, comments, yaml);
     return writeOutput(args, yaml.str(), "make_scenario", out, err);

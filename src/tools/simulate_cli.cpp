@@ -1,13 +1,16 @@
 #include "variational_formation/tools/simulate_cli.hpp"
 
 #include <cstdint>
+#include <cstdio>
 #include <fstream>
+#include <memory>
 #include <ostream>
 
 #include "variational_formation/core/delayed_integrator.hpp"
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/shape_outcome.hpp"
 #include "variational_formation/core/tracking.hpp"
+#include "variational_formation/core/run_tracker.hpp"
 #include "variational_formation/core/simulation.hpp"
 #include "variational_formation/tools/arguments.hpp"
 #include "variational_formation/tools/scenario_path.hpp"
@@ -24,15 +27,18 @@ const char* kUsage =
     "                [--commands FILE.csv]   (vi only; replaces the scenario's manoeuvre)\n"
     "Runs a formation scenario centrally. traj.csv: step,t,agent,x,y,z;\n"
     "metrics.csv: step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error,\n"
-    "shape_error. The last line on stdout says how the formation ended: 'formation: converged to the\n"
-    "desired shape ...', 'formation: edges converged but the shape is not the desired one ...' or\n"
-    "'formation: not converged ...'; with `assignment: auto` a line 'assignment: ...' comes first.\n"
+    "shape_error (and min_separation under a scenario's safety: filter). The last line on stdout says\n"
+    "how the formation ended: 'formation: converged to the desired shape ...', 'formation: edges\n"
+    "converged but the shape is not the desired one ...' or 'formation: not converged ...'; with\n"
+    "`assignment: auto` a line 'assignment: ...' comes first, and with safety: a line 'simulate:\n"
+    "formation ...' before the last gives the closest approach and whether the run was blocked.\n"
     "--commands: rows step,vx,vy,vz,wx,wy,wz,scale, each applying from its step on\n"
     "(doc/manoeuvres.md).\n"
     "Flags override the scenario file. --delay-steps D: each agent uses its neighbours'\n"
     "q_j^{k-D}; --loss P: each neighbour state is lost with probability P (seed S, default 1).\n"
-    "Exit status 2 on bad input, 1 if the run diverges, or if the scenario has\n"
-    "require_convergence: true and the formation did not reach the desired shape.\n";
+    "Exit status 2 on bad input, 1 if the run diverges, if a run under safety: is blocked or misses\n"
+    "a required convergence, or if the scenario has require_convergence: true and the formation\n"
+    "did not reach the desired shape.\n";
 
 std::ofstream openOutput(const std::string& flag, const std::string& path) {
   std::ofstream out(path);
@@ -63,6 +69,25 @@ bool parseDelayFlags(const Arguments& args, Method method, DelaySettings& delay)
         args.integer("--seed", 0, std::numeric_limits<long>::max()));
   }
   return true;
+}
+
+/// The last line of a tracked run, and its exit status (finishedRunVerdict).
+int reportOutcome(const RunTracker& tracker, const Scenario& scenario, std::ostream& out, std::ostream& err) {
+  const FormationOutcome formation = tracker.outcome();
+  out << "simulate: formation " << formation.line;
+  if (scenario.safety) {
+    const ClosestPair& c = tracker.closestApproach();
+    char distance[32];
+    std::snprintf(distance, sizeof distance, "%.4g", c.distance);
+    out << "; closest approach " << distance << " m";
+    if (c.first >= 0) out << " (agents " << c.first << ", " << c.second << " at step " << tracker.closestApproachStep() << ")";
+    out << "; filter active in " << tracker.filterActiveSteps() << " steps";
+  }
+  out << '\n';
+  const RunVerdict verdict = finishedRunVerdict(scenario, formation);
+  if (verdict.succeeded) return kExitOk;
+  err << "simulate: error: " << verdict.reason << '\n';
+  return kExitFailure;
 }
 
 }  // namespace
@@ -102,6 +127,8 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
       schedule = args.has("--commands") ? loadCommands(args.text("--commands"), scenario)
                                         : scheduleFromSegments(scenario.manoeuvre, scenario.timeStep);
     }
+    if (scenario.safety && delayed) throw InvalidInput("safety: not with --delay-steps or --loss");
+    checkSafetyMethod(scenario, method);
     for (const std::string& w : scenario.warnings) err << "simulate: warning: " << w << '\n';
     if (scenario.autoAssignment) out << "assignment: " << scenario.assignment.describe() << '\n';
 
@@ -110,10 +137,14 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
     const bool withMetrics = args.has("--metrics");
     if (withMetrics) metrics = openOutput("--metrics", args.text("--metrics"));
     writeTrajectoryHeader(traj);
-    if (withMetrics) writeMetricsHeader(metrics);
+    const bool safety = scenario.safety.has_value();
+    if (withMetrics) writeMetricsHeader(metrics, safety);
     long divergedAt = -1;
     const Formation formation = makeFormation(scenario);
     ShapeTracker shape(formation, scenario.mirrorAllowed);
+    // Under a safety filter: the closest approach, the filter's activity, and a blocked run ends.
+    std::unique_ptr<RunTracker> tracker;
+    if (safety) tracker = std::make_unique<RunTracker>(scenario, schedule);
     const auto observe = [&](const Integrator& integrator) {
       const long k = integrator.stepIndex();
       Velocities v = integrator.velocities();
@@ -121,17 +152,16 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
       shape.observe(k, integrator.positions(), v, integrator.commandedScale());
       writeTrajectoryRows(traj, integrator.stepIndex(), integrator.time(),
                           integrator.positions());
-      if (withMetrics) writeMetricsRow(metrics, measure(integrator));
+      if (withMetrics) writeMetricsRow(metrics, measure(integrator), safety);
       if (divergedAt < 0 && !integrator.positions().allFinite()) {
         divergedAt = integrator.stepIndex();
       }
+      return !tracker || tracker->observe(integrator);
     };
-    if (manoeuvre) {
-      runManoeuvre(scenario, start, schedule, observe);
-    } else if (delayed) {
-      runDelayedScenario(scenario, start, delay, observe);
+    if (delayed) {
+      runDelayedScenario(scenario, start, delay, [&](const Integrator& integrator) { observe(integrator); });
     } else {
-      runScenario(scenario, method, start, observe);
+      runCentralised(scenario, method, start, manoeuvre ? &schedule : nullptr, observe);
     }
     traj.flush();
     if (withMetrics) metrics.flush();
@@ -144,8 +174,10 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
           << " (try a smaller --time-step)\n";
       return kExitFailure;
     }
+    const int safetyStatus = tracker ? reportOutcome(*tracker, scenario, out, err) : kExitOk;
     const ShapeOutcome outcome = shape.outcome(scenario.timeStep);
     out << "formation: " << outcome.line << '\n';
+    if (safetyStatus != kExitOk) return safetyStatus;
     if (scenario.requireConvergence && outcome.verdict != ShapeVerdict::DesiredShape) {
       err << "simulate: error: the formation did not reach the desired shape, and the scenario requires it "
              "(require_convergence: true)\n";

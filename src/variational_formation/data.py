@@ -16,6 +16,8 @@ METRICS_HEADER = ("step,t,energy,max_distance_error,px,py,pz,ax,ay,az,"
                   "cvx,cvy,cvz,wx,wy,wz,scale_error,shape_error")
 # metrics.csv as simulate wrote it before the shape error; still read (shape_error = NaN).
 METRICS_HEADER_WITHOUT_SHAPE = METRICS_HEADER[:-len(",shape_error")]
+# metrics.csv of a run with a safety: filter: one more column, the closest pair at each step.
+METRICS_HEADER_WITH_SEPARATION = METRICS_HEADER + ",min_separation"
 # metrics.csv as simulate wrote it before the tracking columns; still read (tracking = NaN).
 METRICS_HEADER_WITHOUT_TRACKING = "step,t,energy,max_distance_error,px,py,pz,ax,ay,az"
 COMMANDS_HEADER = "step,vx,vy,vz,wx,wy,wz,scale"
@@ -63,13 +65,16 @@ def bag_parts(path):
 
 def read_metrics(path):
     """simulate's metrics.csv: t, energy, max_distance_error, p[k, 3], a[k, 3], and the tracking
-    columns: centroid velocity cv[k, 3], rotation rate w[k, 3], mean scale error scale_error[k], and the
-    shape error over all pairs shape_error[k]."""
-    m = load_csv(path, METRICS_HEADER, METRICS_HEADER_WITHOUT_SHAPE, METRICS_HEADER_WITHOUT_TRACKING)
-    if m.shape[1] < 18:
-        m = np.hstack([m, np.full((m.shape[0], 18 - m.shape[1]), np.nan)])
+    columns: centroid velocity cv[k, 3], rotation rate w[k, 3], mean scale error scale_error[k], the
+    shape error over all pairs shape_error[k], and min_separation[k] (the closest pair; NaN without
+    a safety: filter)."""
+    m = load_csv(path, METRICS_HEADER, METRICS_HEADER_WITH_SEPARATION, METRICS_HEADER_WITHOUT_SHAPE,
+                 METRICS_HEADER_WITHOUT_TRACKING)
+    if m.shape[1] < 19:
+        m = np.hstack([m, np.full((m.shape[0], 19 - m.shape[1]), np.nan)])
     return types.SimpleNamespace(t=m[:, 1], energy=m[:, 2], error=m[:, 3], p=m[:, 4:7], a=m[:, 7:10],
-                                 cv=m[:, 10:13], w=m[:, 13:16], scale_error=m[:, 16], shape_error=m[:, 17])
+                                 cv=m[:, 10:13], w=m[:, 13:16], scale_error=m[:, 16], shape_error=m[:, 17],
+                                 min_separation=m[:, 18])
 
 
 def commanded_velocities(scenario_path, steps, h, commands=None):

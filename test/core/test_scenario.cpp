@@ -29,24 +29,8 @@ const std::string kEdges = "edges: [[0, 1], [1, 2], [2, 0]]\n";
 
 std::string valid() { return kHeader + kAgents + kEdges; }
 
-std::string replaced(std::string text, const std::string& from, const std::string& to) {
-  const auto at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  return text.replace(at, from.size(), to);
-}
-
-// Expects InvalidInput whose message contains every fragment.
-void expectError(const std::string& yaml, std::initializer_list<std::string> fragments) {
-  try {
-    parseScenario(yaml, "file.yaml");
-    ADD_FAILURE() << "accepted:\n" << yaml;
-  } catch (const InvalidInput& e) {
-    const std::string what = e.what();
-    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
-    EXPECT_EQ(what.rfind("file.yaml: ", 0), 0u) << what;
-    for (const auto& f : fragments) EXPECT_NE(what.find(f), std::string::npos) << what << " / " << f;
-  }
-}
+using test::expectError;
+using test::replaced;
 
 TEST(Scenario, ValidFileLoads) {
   const Scenario s = parseScenario(valid(), "file.yaml");

@@ -1,10 +1,13 @@
 #pragma once
 // Small fixtures shared by the core tests.
 
-#include <string>
+#include <gtest/gtest.h>
 
+#include <initializer_list>
+#include <string>
 #include <vector>
 
+#include "variational_formation/core/error.hpp"
 #include "variational_formation/core/manoeuvre_command.hpp"
 #include "variational_formation/core/manoeuvre_integrator.hpp"
 #include "variational_formation/core/scenario.hpp"
@@ -14,6 +17,27 @@ namespace test {
 
 inline std::string configPath(const std::string& name) {
   return std::string(VF_SOURCE_DIR) + "/config/" + name + ".yaml";
+}
+
+/// `text` with the first `from` replaced by `to` (a failure if there is none).
+inline std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return text.replace(at, from.size(), to);
+}
+
+/// Expects parseScenario(yaml, "file.yaml") to throw InvalidInput: one line, prefixed by the
+/// file, containing every fragment.
+inline void expectError(const std::string& yaml, std::initializer_list<std::string> fragments) {
+  try {
+    parseScenario(yaml, "file.yaml");
+    ADD_FAILURE() << "accepted:\n" << yaml;
+  } catch (const InvalidInput& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    EXPECT_EQ(what.rfind("file.yaml: ", 0), 0u) << what;
+    for (const auto& f : fragments) EXPECT_NE(what.find(f), std::string::npos) << what << " / " << f;
+  }
 }
 
 /// A 2D triangle (side 1) with its three edges.

@@ -2,11 +2,14 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "variational_formation/core/formation.hpp"
 #include "variational_formation/core/variational_update.hpp"
 
 namespace vf {
+
+class SafetyStage;
 
 /// Which scheme integrates the closed loop q'' = -kappa q' - grad V (paper eq. (formation3)).
 enum class Method { Variational, ExplicitEuler, RungeKutta4 };
@@ -38,6 +41,14 @@ class Integrator {
   /// The scale s the desired distances are multiplied by at step k (1 without a manoeuvre).
   virtual double commandedScale() const { return 1.0; }
 
+  /**
+   * Sends every later step through the safety filter (DESIGN.md §7). Only the variational
+   * integrators (plain and under commands) apply it; without one, today's steps bit for bit.
+   */
+  void attachSafety(std::shared_ptr<SafetyStage> stage) { safety_ = std::move(stage); }
+  /// The attached filter, or nullptr.
+  SafetyStage* safety() const { return safety_.get(); }
+
   long stepIndex() const { return step_; }
   double time() const { return static_cast<double>(step_) * timeStep_; }
   double timeStep() const { return timeStep_; }
@@ -51,6 +62,7 @@ class Integrator {
   double timeStep_;
   double dampingGain_;
   long step_ = 0;
+  std::shared_ptr<SafetyStage> safety_;
 };
 
 /**

@@ -11,7 +11,10 @@ namespace vf {
 struct FormationOutcome {
   bool converged = false;
   double finalError = 0.0;  ///< max distance error at the last completed step [m]
-  /// "converged at step K (t = T s)" or "not converged (final max distance error E m)".
+  /// Why the run stopped short of the shape, "blocked: agents 2, 4" (BlockedDetector), or empty.
+  std::string blocked;
+  /// "converged at step K (t = T s)", "not converged (final max distance error E m)" or
+  /// "not converged (blocked: agents 2, 4)".
   std::string line;
 };
 
@@ -21,6 +24,9 @@ struct FormationOutcome {
  * @param timeStep h [s].
  */
 FormationOutcome formationOutcome(long convergedStep, double finalError, double timeStep);
+/// A run ended because the safety filter blocks the formation: @param blocked
+/// BlockedDetector::description(). @param finalError [m].
+FormationOutcome blockedOutcome(const std::string& blocked, double finalError);
 
 /// The verdict on a run that reached its last step: it succeeded, unless the scenario requires
 /// convergence (`require_convergence: true`) and the formation did not converge.

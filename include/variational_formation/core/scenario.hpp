@@ -1,5 +1,6 @@
 #pragma once
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -7,6 +8,7 @@
 #include "variational_formation/core/formation.hpp"
 #include "variational_formation/core/manoeuvre_command.hpp"
 #include "variational_formation/core/slot_assignment.hpp"
+#include "variational_formation/core/safety.hpp"
 
 namespace vf {
 
@@ -41,6 +43,10 @@ struct Scenario {
   bool autoAssignment = false;
   /// The assignment made at load (slotOfAgent empty without `assignment: auto`).
   SlotAssignment assignment;
+  /// The optional `safety:` block (doc/scenarios.md): every step goes through the safety filter.
+  std::optional<SafetySettings> safety;
+  /// The optional `obstacles:` list (only with `safety:`).
+  std::vector<Obstacle> obstacles;
   /// Non-fatal findings, one line each (a non-rigid desired graph, a too large h).
   std::vector<std::string> warnings;
 

@@ -113,6 +113,17 @@ void validateScenario(Scenario& scenario, bool requireBoundedSteps = false,
  */
 void validateManoeuvre(Scenario& scenario, const Formation& formation, const FieldNames& names = {});
 
+/**
+ * Checks a scenario's `safety:` and `obstacles:` (part of validateScenario; doc/scenarios.md):
+ * r > 0, sensing_radius > r, γ in (0, 1], max_speed and blocked_after > 0, obstacles only with
+ * safety, radius >= 0 and min <= max; no two desired positions closer than r (at the
+ * manoeuvre's smallest scale if it shrinks the shape), no two starts closer than r, and no start
+ * closer than r/2 to an obstacle. Appends a warning when steps are long enough to cross the gap
+ * R - r between sensing and contact.
+ * @throws InvalidInput naming the field, the value and why.
+ */
+void validateSafety(Scenario& scenario);
+
 /// The initial headings (`initial_heading`): none, or one finite value [rad] per agent, planar
 /// scenarios only. @throws InvalidInput naming the field.
 void validateInitialHeadings(const Scenario& scenario);

@@ -1,0 +1,50 @@
+#include "variational_formation/core/run_tracker.hpp"
+
+#include "variational_formation/core/safety_stage.hpp"
+#include "variational_formation/core/tracking.hpp"
+
+namespace vf {
+
+namespace {
+const std::vector<int> kNone;
+}  // namespace
+
+RunTracker::RunTracker(const Scenario& scenario, const CommandSchedule& schedule)
+    : scenario_(scenario),
+      schedule_(schedule),
+      congruence_(0.01, 0.1),  // the monitor's defaults (doc/maths.md §8)
+      blocked_(scenario.safety ? scenario.safety->blockedAfter : 1.0, scenario.timeStep) {}
+
+bool RunTracker::observe(const Integrator& integrator) {
+  const long step = integrator.stepIndex();
+  const Positions& q = integrator.positions();
+  const double scale = integrator.commandedScale();
+  lastError_ = integrator.formation().maxDistanceError(q, scale);
+  Velocities v = integrator.velocities();
+  if (!schedule_.empty()) subtractCommandedMotion(schedule_.at(step > 0 ? step - 1 : 0), q, v);
+  const bool congruent = congruence_.check(integrator.formation(), q, v, scale);
+  if (!congruent) {
+    convergedStep_ = -1;
+  } else if (convergedStep_ < 0) {
+    convergedStep_ = step;
+  }
+  SafetyStage* safety = integrator.safety();
+  if (!safety) return true;
+  const ClosestPair pair = safety->closestPair(q, step);
+  if (closestStep_ < 0 || pair.distance < closest_.distance) {
+    closest_ = pair;
+    closestStep_ = step;
+  }
+  // The half-spaces that bound in the step that produced q (none at step 0).
+  const bool stepped = step > 0;
+  if (stepped && !safety->bindingAgents().empty()) ++filterActiveSteps_;
+  return !blocked_.update(step, lastError_, congruent, stepped ? safety->bindingAgents() : kNone,
+                          stepped ? safety->bindingObstacles() : kNone);
+}
+
+FormationOutcome RunTracker::outcome() const {
+  if (blocked_.blocked()) return blockedOutcome(blocked_.description(), lastError_);
+  return formationOutcome(convergedStep_, lastError_, scenario_.timeStep);
+}
+
+}  // namespace vf

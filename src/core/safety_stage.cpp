@@ -1,0 +1,60 @@
+#include "variational_formation/core/safety_stage.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace vf {
+
+SafetyStage::SafetyStage(const SafetySettings& settings, std::vector<Obstacle> obstacles, double timeStep)
+    : settings_(settings), obstacles_(std::move(obstacles)), timeStep_(timeStep) {}
+
+void SafetyStage::sense(const Positions& q, long step) {
+  if (sensedStep_ == step) return;
+  sensedStep_ = step;
+  grid_.build(q, settings_.sensingRadius);
+}
+
+ClosestPair SafetyStage::closestPair(const Positions& q, long step) {
+  sense(q, step);
+  const ClosestPair best = grid_.closestWithin(q, settings_.sensingRadius);
+  if (best.first < 0) return vf::closestPair(q, 2.0 * settings_.sensingRadius);  // nobody within R
+  return best;
+}
+
+void SafetyStage::apply(const Positions& q, long step, Positions& qNext) {
+  sense(q, step);
+  const int d = static_cast<int>(q.rows());
+  bindingAgents_.clear();
+  bindingObstacles_.clear();
+  speedLimited_ = 0;
+  for (int i = 0; i < q.cols(); ++i) {
+    near_.clear();
+    grid_.within(q, i, settings_.sensingRadius, near_);
+    scratch_.clear();
+    for (int j : near_) {
+      SensedAgent a;
+      a.id = j;
+      for (int c = 0; c < d; ++c) a.position[c] = q(c, a.id);
+      scratch_.push_back(a);
+    }
+    const SafeStep s =
+        filterNextPosition(settings_, timeStep_, d, q.col(i).data(), qNext.col(i).data(), scratch_, obstacles_);
+    if (s.projection.speedLimited) ++speedLimited_;
+    if (!s.projection.active.empty()) bindingAgents_.push_back(i);
+    for (int m : s.projection.active) {
+      const int source = s.constraints[static_cast<std::size_t>(m)].source;
+      if (source >= 0) {
+        bindingAgents_.push_back(source);
+      } else {
+        bindingObstacles_.push_back(-1 - source);
+      }
+    }
+  }
+  for (std::vector<int>* v : {&bindingAgents_, &bindingObstacles_}) {
+    std::sort(v->begin(), v->end());
+    v->erase(std::unique(v->begin(), v->end()), v->end());
+  }
+}
+
+}  // namespace vf
