@@ -87,14 +87,18 @@ if(CATKIN_ENABLE_TESTING)
   target_link_libraries(test_call_pool variational_formation_ros gtest_main)
   target_compile_options(test_call_pool PRIVATE ${VF_FLAGS})
   # Simulated robots (test/ros/robots_run.test): the hexagon with holonomic robots and with
-  # unicycles from seeded headings; ring7 (delay margin 0.05 s) with lags 0.1 and 0.3 s.
+  # unicycles from seeded headings; ring7 (delay margin 0.05 s) with lags 0.1 and 0.3 s; the hexagon
+  # in the MuJoCo world.
   foreach(case "case:=hexagon"
                "case:=hexagon_unicycle kinematics:=unicycle heading_seed:=7 world_frame:=map"
                "case:=hexagon_unicycle_command kinematics:=unicycle heading_seed:=9 command:=0.3_-0.2"
                "case:=ring7_lag01 scenario:=ring7 lag:=0.1 time_limit:=90 expect_lag_warning:=true"
                "case:=ring7_lag03 scenario:=ring7 lag:=0.3 time_limit:=90 expect_lag_warning:=true"
                "case:=ring7_unicycle_lag01 scenario:=ring7 lag:=0.1 kinematics:=unicycle heading_seed:=3 time_limit:=90 expect_lag_warning:=true"
-               "case:=ring7_unicycle_lag03 scenario:=ring7 lag:=0.3 kinematics:=unicycle heading_seed:=5 time_limit:=90 expect_lag_warning:=true")
+               "case:=ring7_unicycle_lag03 scenario:=ring7 lag:=0.3 kinematics:=unicycle heading_seed:=5 time_limit:=90 expect_lag_warning:=true"
+               # The MuJoCo world (doc/robots.md): the same hexagon, unicycles and holonomic bases.
+               "case:=mujoco_unicycle world:=mujoco kinematics:=unicycle heading_seed:=7"
+               "case:=mujoco_holonomic world:=mujoco")
     separate_arguments(args UNIX_COMMAND "${case}")
     add_rostest(test/ros/robots_run.test ARGS ${args})
   endforeach()

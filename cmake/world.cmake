@@ -13,10 +13,11 @@ if(NOT mujoco_FOUND OR NOT VF_MUJOCO_INCLUDE_DIR OR NOT VF_MUJOCO_LIBRARY)
     "scripts/test.sh installs it from package.xml's key libmujoco-dev).")
 endif()
 
-add_library(variational_formation_world src/world/world_settings.cpp src/world/mjcf_model.cpp
-  src/world/contact_log.cpp src/world/wheel_odometry.cpp src/world/mujoco_world.cpp src/world/step_response.cpp)
-target_include_directories(variational_formation_world SYSTEM PUBLIC ${VF_MUJOCO_INCLUDE_DIR})
-target_link_libraries(variational_formation_world PUBLIC variational_formation_core ${VF_MUJOCO_LIBRARY})
+add_library(variational_formation_world src/world/contact_log.cpp src/world/mjcf_model.cpp
+  src/world/mujoco_world.cpp src/world/step_response.cpp src/world/wheel_odometry.cpp src/world/world_settings.cpp)
+# Private: the world's headers declare MuJoCo's types without including mujoco.h.
+target_include_directories(variational_formation_world SYSTEM PRIVATE ${VF_MUJOCO_INCLUDE_DIR})
+target_link_libraries(variational_formation_world PUBLIC variational_formation_core PRIVATE ${VF_MUJOCO_LIBRARY})
 target_compile_options(variational_formation_world PRIVATE ${VF_FLAGS})
 set_target_properties(variational_formation_world PROPERTIES POSITION_INDEPENDENT_CODE ON)
 install(TARGETS variational_formation_world
@@ -38,8 +39,15 @@ install(TARGETS mujoco_world RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATIO
 if(CATKIN_ENABLE_TESTING)
   foreach(name mjcf_model mujoco_world)
     catkin_add_gtest(test_${name} test/world/test_${name}.cpp)
-    target_link_libraries(test_${name} variational_formation_world gtest_main)
+    # The model test loads the MJCF with MuJoCo itself.
+    target_include_directories(test_${name} SYSTEM PRIVATE ${VF_MUJOCO_INCLUDE_DIR})
+    target_link_libraries(test_${name} variational_formation_world ${VF_MUJOCO_LIBRARY} gtest_main)
     target_compile_options(test_${name} PRIVATE ${VF_FLAGS})
     target_compile_definitions(test_${name} PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   endforeach()
 endif()
+
+# Its real-time factor against the robot count, for the checkout only (like benchmark_roa).
+add_executable(benchmark_world benchmark/benchmark_world.cpp)
+target_link_libraries(benchmark_world variational_formation_world)
+target_compile_options(benchmark_world PRIVATE ${VF_FLAGS})

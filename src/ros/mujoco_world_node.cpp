@@ -25,7 +25,11 @@ namespace {
 WorldSettings worldSettings(const ros::NodeHandle& pnh) {
   WorldSettings settings;
   settings.kinematics = parseWorldKinematics(optionalParam<std::string>(pnh, "kinematics", "holonomic"));
-  for (const std::string& name : worldParameterNames()) {
+  // Spelled out (not worldParameterNames()) so that test/doc/test_docs.py sees each read;
+  // setWorldParameter refuses a name the settings do not have.
+  for (const char* name : {"time_step", "real_time_factor", "friction", "mass", "body_radius", "hand_offset",
+                           "wheel_radius", "track", "max_wheel_torque", "max_wheel_speed", "wheel_gain",
+                           "wheel_armature", "caster_friction", "max_force", "max_speed", "base_gain"}) {
     if (pnh.hasParam(name)) setWorldParameter(settings, name, requiredParam<double>(pnh, name));
   }
   validateWorldSettings(settings);
