@@ -83,7 +83,8 @@ if(CATKIN_ENABLE_TESTING)
   target_link_libraries(test_call_pool variational_formation_ros gtest_main)
   target_compile_options(test_call_pool PRIVATE ${VF_FLAGS})
   # Simulated robots (test/ros/robots_run.test): the hexagon with holonomic robots and with
-  # unicycles from seeded headings; ring7 (delay margin 0.05 s) with lags 0.1 and 0.3 s.
+  # unicycles from seeded headings; ring7 (delay margin 0.05 s) with lags 0.1 and 0.3 s; the hexagon
+  # in the MuJoCo world (doc/robots.md), unicycles and holonomic bases.
   vf_add_rostest_cases(test/ros/robots_run.test
     "case:=hexagon"
     "case:=hexagon_unicycle kinematics:=unicycle heading_seed:=7 world_frame:=map"
@@ -91,7 +92,9 @@ if(CATKIN_ENABLE_TESTING)
     "case:=ring7_lag01 scenario:=ring7 lag:=0.1 time_limit:=90 expect_lag_warning:=true"
     "case:=ring7_lag03 scenario:=ring7 lag:=0.3 time_limit:=90 expect_lag_warning:=true"
     "case:=ring7_unicycle_lag01 scenario:=ring7 lag:=0.1 kinematics:=unicycle heading_seed:=3 time_limit:=90 expect_lag_warning:=true"
-    "case:=ring7_unicycle_lag03 scenario:=ring7 lag:=0.3 kinematics:=unicycle heading_seed:=5 time_limit:=90 expect_lag_warning:=true")
+    "case:=ring7_unicycle_lag03 scenario:=ring7 lag:=0.3 kinematics:=unicycle heading_seed:=5 time_limit:=90 expect_lag_warning:=true"
+    "case:=mujoco_unicycle world:=mujoco kinematics:=unicycle heading_seed:=7"
+    "case:=mujoco_holonomic world:=mujoco")
   # render_bag.py on a recorded hexagon: video length, frames, processes left, bad inputs; and on
   # robots.launch's wall-time bag: the video is the run from its first step, one name per robot.
   add_rostest(test/ros/render.test ARGS kind:=formation)

@@ -12,11 +12,15 @@ usage: make_agents_launch.py --scenario FILE --out FILE [--rate R] [--order forw
                              [--mode lockstep|timed [--delay S] [--jitter S] [--loss P] [--max-age S]
                               [--seed N] [--respawn-delay S] [--robot true|false [--lag S] [--noise M]
                                [--kinematics holonomic|unicycle] [--feedback integrated|odometry]
-                               [--hand-offset M] [--heading-seed N] [--heading-noise RAD]]]
+                               [--hand-offset M] [--heading-seed N] [--heading-noise RAD]
+                               [--world kinematic|mujoco [--physics-step S] [--friction F]]]]
                              [--ids LIST] [--manager-name NAME] [--agent-manager NAMES] [--in-launch]
 With --robot true (timed mode), each agent also gets a simulated robot, robot_sim, in
 formation/robot_<id> (odom and cmd_vel there), started at the scenario's initial position (a
 unicycle's hand point there, at the scenario's initial_heading or one drawn from --heading-seed).
+With --world mujoco the robots are not robot_sim nodes but bodies of one MuJoCo world, which
+robots.launch starts (mujoco_world); the agents' robot lag is then the world's measured step
+response (world_step_response, with the world's --physics-step and --friction), not --lag.
 With --nodelet true (lockstep mode), every agent is a nodelet of one manager, formation/manager
 (the agent_manager node, which loads them itself; doc/distributed.md, "Nodelets"), instead of a
 node of its own.
@@ -160,7 +164,18 @@ def agent_count(scenario, rate):
     return int(info.stdout.split()[1])
 
 
-def timed_args(args, i):
+def world_lag(args):
+    """The lag of the MuJoCo world's robots: the time their speed takes to 63.2% of a step."""
+    response = subprocess.run(["rosrun", "variational_formation", "world_step_response", "--kinematics", args.kinematics,
+                               "--time_step", args.physics_step, "--friction", args.friction],
+                              capture_output=True, text=True)
+    if response.returncode != 0:
+        lines = response.stderr.strip().splitlines() or ["world_step_response failed"]
+        fail(lines[-1].replace("world_step_response: error: ", ""))
+    return response.stdout.split()[1]
+
+
+def timed_args(args, i, lag):
     if args.mode != "timed":
         return ()
     # One fault stream per agent: seed + id.
@@ -168,7 +183,7 @@ def timed_args(args, i):
             ("jitter", args.jitter), ("loss", args.loss),
             ("max_age", args.max_age), ("seed", str(args.seed + i)), ("robot", args.robot)) + (
                 (("kinematics", args.kinematics), ("feedback", args.feedback), ("hand_offset", args.hand_offset),
-                 ("robot_lag", args.lag)) if args.robot == "true" else ())
+                 ("robot_lag", lag)) if args.robot == "true" else ())
 
 
 def robot_sim(args, i):
@@ -218,6 +233,9 @@ def main():
     parser.add_argument("--hand-offset", type=positive("hand_offset"), default="0.1")
     parser.add_argument("--heading-seed", type=seed, default=0)
     parser.add_argument("--heading-noise", type=non_negative("heading_noise"), default="0.01")
+    parser.add_argument("--world", choices=("kinematic", "mujoco"), default="kinematic")
+    parser.add_argument("--physics-step", type=positive("physics_step"), default="0.002")
+    parser.add_argument("--friction", type=positive("friction"), default="1")
     parser.add_argument("--nodelet", type=boolean("nodelet"), default="false")
     parser.add_argument("--nodelet-threads", type=non_negative_int("nodelet_threads"), default="0")
     parser.add_argument("--ids", type=id_list, default=None,
@@ -236,6 +254,8 @@ def main():
         fail("nodelet: only lockstep agents are nodelets; run timed agents as nodes (nodelet:=false)")
     if args.mode == "timed" and float(args.rate) <= 0:
         fail(f"rate: must be > 0 in timed mode (the tick period is h / rate), got {args.rate}")
+    if args.world == "mujoco" and args.robot != "true":
+        fail("world: a MuJoCo world holds robots: it needs robot true")
     if args.nodelet != "true" and (args.manager_name != "manager" or args.agent_manager):
         fail("manager_name, agent_manager: only with nodelet true")
     count = agent_count(args.scenario, args.rate)
@@ -254,15 +274,19 @@ def main():
     if args.nodelet == "true":
         lines += manager(args, ids)
         ids = []
+    lag = args.lag
+    if args.world == "mujoco":
+        lag = world_lag(args)
+        lines.append(f"  <!-- the MuJoCo world's robots (robots.launch starts it): measured lag {lag} s -->")
     for position, i in enumerate(ids):
         delay = position * float(args.stagger)
         prefix = f"bash -c 'sleep {delay:g}; exec \"$0\" \"$@\"'" if delay > 0 else ""
         lines.append('  <include file="$(find variational_formation)/launch/agent.launch">')
         for name, value in (("id", str(i)), ("scenario", args.scenario), ("rate", args.rate),
-                            ("respawn", args.respawn), ("launch_prefix", prefix)) + timed_args(args, i):
+                            ("respawn", args.respawn), ("launch_prefix", prefix)) + timed_args(args, i, lag):
             lines.append(f"    <arg name={quoteattr(name)} value={quoteattr(value)}/>")
         lines.append("  </include>")
-        if args.robot == "true":
+        if args.robot == "true" and args.world == "kinematic":
             lines += robot_sim(args, i)
     lines.append("</launch>")
     try:

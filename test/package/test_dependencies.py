@@ -17,12 +17,12 @@ EXEC = ("depend", "exec_depend")
 TEST = ("test_depend",)
 # An include folder or Python module that is not named after its rosdep key.
 INCLUDE_KEYS = {"Eigen": "eigen", "yaml-cpp": "yaml-cpp", "gtest": "gtest", "benchmark": "benchmark",
-                "ros": "roscpp", "XmlRpc": "roscpp", "variational_formation": None}
+                "mujoco": "libmujoco-dev", "ros": "roscpp", "XmlRpc": "roscpp", "variational_formation": None}
 SYSTEM_INCLUDES = {"sys", "arpa", "netinet", "bits"}  # the C library
 PYTHON_KEYS = {"numpy": "python3-numpy", "yaml": "python3-yaml", "matplotlib": "python3-matplotlib",
                "rospkg": "python3-rospkg", "variational_formation": None}
 FIND_PACKAGE_KEYS = {"Eigen3": "eigen", "yaml-cpp": "yaml-cpp", "Threads": None, "benchmark": "benchmark",
-                     "catkin": "catkin"}
+                     "catkin": "catkin", "mujoco": "libmujoco-dev"}
 
 
 def declared():
