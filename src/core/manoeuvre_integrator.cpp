@@ -53,7 +53,7 @@ void ManoeuvreIntegrator::step() {
       paperStart(coefficients_, d, q_.col(i).data(), v0_.col(i).data(), next);
     }
   }
-  if (safety_) safety_->apply(q_, step_, qNext_);  // DESIGN.md §7, after every agent's update
+  if (safety_) safety_->apply(q_, step_, qNext_);  // doc/maths.md §10, after every agent's update
   qPrev_.swap(q_);
   q_.swap(qNext_);
   ++step_;

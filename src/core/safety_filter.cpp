@@ -265,7 +265,7 @@ void safetyConstraints(const SafetySettings& s, int d, const double* q, const st
     for (int a = 0; a < d; ++a) c.normal[a] = q[a] - sensed[j].position[a];
     const double zz = dot(d, c.normal, c.normal);
     if (!(zz < reach2)) continue;
-    // DESIGN.md §7, pairs: 2 z·δ >= -(γ/2)(|z|^2 - r^2); agent j states the same with -z.
+    // doc/maths.md §10, pairs: 2 z·δ >= -(γ/2)(|z|^2 - r^2); agent j states the same with -z.
     for (int a = 0; a < d; ++a) c.normal[a] *= 2.0;
     c.bound = std::min(0.0, -0.5 * s.gamma * (zz - r2));
     c.source = sensed[j].id;
@@ -277,7 +277,7 @@ void safetyConstraints(const SafetySettings& s, int d, const double* q, const st
     obstacleOffset(obstacles[k], d, q, c.normal);
     const double ww = dot(d, c.normal, c.normal);
     if (!(ww < reach2)) continue;
-    // DESIGN.md §7, obstacles: 2 w·δ >= -γ(|w|^2 - (r/2)^2).
+    // doc/maths.md §10, obstacles: 2 w·δ >= -γ(|w|^2 - (r/2)^2).
     for (int a = 0; a < d; ++a) c.normal[a] *= 2.0;
     c.bound = std::min(0.0, -s.gamma * (ww - clearance2));
     c.source = -1 - static_cast<int>(k);

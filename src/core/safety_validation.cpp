@@ -88,7 +88,7 @@ void validateSafety(Scenario& s) {
       }
     }
   }
-  // DESIGN.md §7: pairs beyond R state no constraint, so one step of each must not close the gap
+  // doc/maths.md §10: pairs beyond R state no constraint, so one step of each must not close the gap
   // R - r (without max_speed only the run's speeds bound it: doc/maths.md §10).
   const double reach = 2.0 * safety.maxSpeed * s.timeStep;
   if (std::isfinite(reach) && !(reach < safety.sensingRadius - safety.radius)) {

@@ -26,7 +26,7 @@ void VariationalIntegrator::step() {
     variationalStep(coefficients_, start_, step_, d, qPrev_.col(i).data(), q_.col(i).data(),
                     v0_.col(i).data(), g, qNext_.col(i).data());
   }
-  if (safety_) safety_->apply(q_, step_, qNext_);  // DESIGN.md §7, after every agent's update
+  if (safety_) safety_->apply(q_, step_, qNext_);  // doc/maths.md §10, after every agent's update
   qPrev_.swap(q_);
   q_.swap(qNext_);
   ++step_;

@@ -1,4 +1,4 @@
-// The safety filter (DESIGN.md §7): the projection against its KKT conditions on random
+// The safety filter (doc/maths.md §10): the projection against its KKT conditions on random
 // constraint sets, the discrete guarantee over random steps, and no change at all while nothing
 // binds.
 #include <gtest/gtest.h>
@@ -211,7 +211,7 @@ std::vector<Eigen::Vector3d> scatter(std::mt19937_64& engine, int d, int n, doub
   return q;
 }
 
-// DESIGN.md §7: when every agent filters its own δ0 with the others' step-(k+1) positions,
+// doc/maths.md §10: when every agent filters its own δ0 with the others' step-(k+1) positions,
 // b(z^{k+2}) >= (1 - γ) b(z^{k+1}) for every sensed pair, and the same with (r/2)^2 for obstacles:
 // no pair ever gets closer than r, no agent closer than r/2 to an obstacle. Steps are drawn at
 // random, large and aimed at each other, so that the filter binds often.

@@ -42,7 +42,7 @@ class Integrator {
   virtual double commandedScale() const { return 1.0; }
 
   /**
-   * Sends every later step through the safety filter (DESIGN.md §7). Only the variational
+   * Sends every later step through the safety filter (doc/maths.md §10). Only the variational
    * integrators (plain and under commands) apply it; without one, today's steps bit for bit.
    */
   void attachSafety(std::shared_ptr<SafetyStage> stage) { safety_ = std::move(stage); }

@@ -6,7 +6,7 @@
 
 namespace vf {
 
-/// The scenario's optional `safety:` block (doc/scenarios.md, DESIGN.md §7).
+/// The scenario's optional `safety:` block (doc/scenarios.md, doc/maths.md §10).
 struct SafetySettings {
   double radius = 0.0;         ///< r [m]: no two agents' centres come closer than this
   double sensingRadius = 0.0;  ///< R [m] > r: agents and obstacles nearer than this are sensed
@@ -29,7 +29,7 @@ struct Obstacle {
 };
 
 /**
- * w = q - p, p the obstacle's nearest point to q (DESIGN.md §7): the gradient of
+ * w = q - p, p the obstacle's nearest point to q (doc/maths.md §10): the gradient of
  * dist(q, C)^2 / 2. Zero inside the obstacle.
  * @param q d doubles [m]. @param w receives d doubles [m].
  */

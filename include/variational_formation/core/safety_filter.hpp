@@ -6,7 +6,7 @@
 
 namespace vf {
 
-/// One half-space a·δ >= b of the safe displacements (DESIGN.md §7), d <= 3 used entries.
+/// One half-space a·δ >= b of the safe displacements (doc/maths.md §10), d <= 3 used entries.
 struct HalfSpace {
   double normal[3] = {0.0, 0.0, 0.0};  ///< a [m]
   double bound = 0.0;                  ///< b [m^2]; b <= 0 keeps δ = 0 feasible
@@ -31,7 +31,7 @@ struct Projection {
 };
 
 /**
- * The exact projection (DESIGN.md §7). In d <= 3 the solution lies on the affine set of at most
+ * The exact projection (doc/maths.md §10). In d <= 3 the solution lies on the affine set of at most
  * d independent binding half-spaces, possibly cut by the sphere |δ| = ρ; every such face's
  * nearest point to δ0 is a candidate, and the projection is the feasible candidate nearest to
  * δ0 (the first in a fixed order on ties). Half-spaces no δ with |δ| <= min(|δ0|, ρ) can touch
@@ -52,7 +52,7 @@ struct SensedAgent {
 };
 
 /**
- * Agent i's half-spaces at q = q_i^{k+1} (DESIGN.md §7), in this order: every sensed agent with
+ * Agent i's half-spaces at q = q_i^{k+1} (doc/maths.md §10), in this order: every sensed agent with
  * |z| < R, z = q - q_j, as 2 z·δ >= -(γ/2)(|z|^2 - r^2), in the order given; then every obstacle k
  * with |w| < R, w = q - p_k, as 2 w·δ >= -γ(|w|^2 - (r/2)^2), in list order. Agents farther than R
  * may be passed (they are skipped), so a caller can pass every candidate of a grid's cells.
@@ -72,7 +72,7 @@ struct SafeStep {
 };
 
 /**
- * The safety filter of one agent's step (DESIGN.md §7): the projection of δ0 = q̂^{k+2} - q^{k+1}
+ * The safety filter of one agent's step (doc/maths.md §10): the projection of δ0 = q̂^{k+2} - q^{k+1}
  * onto safetyConstraints and |δ| <= maxSpeed h. The one implementation every run calls.
  * @param q q_i^{k+1}, @param delta0 δ0, d doubles each [m]. @param timeStep h [s].
  */

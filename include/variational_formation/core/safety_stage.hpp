@@ -8,7 +8,7 @@
 namespace vf {
 
 /**
- * The safety filter over a whole formation, as the centralised run applies it (DESIGN.md §7):
+ * The safety filter over a whole formation, as the centralised run applies it (doc/maths.md §10):
  * after every agent's update q̂^{k+2} is computed from the step-(k+1) positions, each agent's
  * displacement is filtered with the step-(k+1) positions of the agents a SpatialGrid finds within
  * the sensing radius (ascending id), through filterNextPosition, the function every run calls.

@@ -53,7 +53,7 @@ void checkSafetyMethod(const Scenario& scenario, Method method);
 /**
  * The centralised run of a validated scenario: runManoeuvre's if `schedule` is given (not
  * nullptr), runScenario's otherwise, with the scenario's safety filter attached if it has one
- * (DESIGN.md §7). Stops early when `observe` returns false. @throws InvalidInput as checkSafetyMethod.
+ * (doc/maths.md §10). Stops early when `observe` returns false. @throws InvalidInput as checkSafetyMethod.
  */
 void runCentralised(const Scenario& scenario, Method method, StartMethod start, const CommandSchedule* schedule,
                     const StepObserver& observe);
