@@ -85,4 +85,20 @@ TEST(LayerGuard, CoreIncludesNothingFromRos) {
   }
 }
 
+// The MuJoCo world (world/) is ROS-free too: what the core may include, the core itself,
+// MuJoCo's header and its own headers.
+TEST(LayerGuard, WorldIncludesNothingFromRos) {
+  const fs::path root(VF_SOURCE_DIR);
+  static const std::regex world("variational_formation/world/[a-z_0-9]+\\.hpp");
+  int files = 0;
+  std::vector<Include> includes = includesUnder(root / "include/variational_formation/world", files);
+  const std::vector<Include> sources = includesUnder(root / "src/world", files);
+  includes.insert(includes.end(), sources.begin(), sources.end());
+  EXPECT_GE(files, 10);  // not vacuous
+  for (const Include& inc : includes) {
+    EXPECT_TRUE(allowedInCore(inc.target) || inc.target == "mujoco/mujoco.h" || std::regex_match(inc.target, world))
+        << inc.file << ":" << inc.line << ": the world includes '" << inc.target << "'";
+  }
+}
+
 }  // namespace
