@@ -7,7 +7,8 @@ r = 0.25 m, R = 1 m, gamma = 0.2, kappa = 2, h = 0.02 s, 3000 steps (60 s); with
 obstacles, and with the filter off for comparison. Prints one table row per case: the closest
 approach of any pair over all runs, the runs in which a pair came closer than r, the closest
 approach to an obstacle's edge (the filter keeps r/2), the share that reached the shape (every
-pair within 1% of the desired distance, speeds below 0.1 m/s: simulate's rule), the median time
+pair within 1% of the desired distance, speeds below 0.1 m/s, the mirror image allowed: simulate's
+verdict on its last line), the median time
 to the shape, and the blocked runs.
 
 usage: benchmark/safety_deployments.py [--runs 100] [--bin DIR]
@@ -70,6 +71,8 @@ def run_case(bin_dir, tmp, agents, obstacles, safety, runs):
         if obstacles and obstacle_clearance(starts[None]) < R_MIN / 2:
             skipped += 1  # a start on an obstacle, which the loader refuses: the same seeds in every case
             continue
+        # Interchangeable robots: the mirror image of the shape is the shape (doc/scenarios.md).
+        text += "mirror: allowed\n"
         if obstacles:
             text += OBSTACLES
         if not safety:
@@ -83,12 +86,16 @@ def run_case(bin_dir, tmp, agents, obstacles, safety, runs):
                            capture_output=True, text=True)
         if r.returncode == 2:
             sys.exit(r.stderr)
-        line = [ln for ln in r.stdout.splitlines() if ln.startswith("simulate: formation")][-1]
-        m = re.search(r"converged at step \d+ \(t = ([0-9.]+) s\)", line)
+        # The last line is the shape's verdict (both cases); under the filter the line before it
+        # says whether the run was blocked.
+        lines = r.stdout.splitlines()
+        verdict = lines[-1]
+        m = re.search(r"at step \d+ \(t = ([0-9.]+) s\)", verdict)
         data = np.loadtxt(traj, delimiter=",", skiprows=1)
         q = data[:, 3:5].reshape(-1, agents, 2)
-        rows.append(dict(converged=line.startswith("simulate: formation converged"),
-                         time=float(m.group(1)) if m else None, blocked="blocked" in line,
+        rows.append(dict(converged=verdict.startswith("formation: converged to the desired shape"),
+                         time=float(m.group(1)) if m else None,
+                         blocked=any(ln.startswith("simulate: formation") and "blocked" in ln for ln in lines),
                          closest=closest_pair(q), clearance=obstacle_clearance(q) if obstacles else None))
         os.remove(traj)
     return rows, skipped
