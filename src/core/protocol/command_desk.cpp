@@ -38,8 +38,6 @@ CommandDesk::CommandDesk(const Scenario& scenario, const CommandLimits& limits)
     : scenario_(scenario), limits_(limits), schedule_(scheduleFromSegments(scenario.manoeuvre, scenario.timeStep)) {
   validateCommandLimits(limits);
   const Formation formation = makeFormation(scenario);
-  softest_ = minStiffnessFrequency(formation, formation.desiredShape());
-  stiffest_ = maxStiffnessFrequency(formation, formation.desiredShape());
   try {
     checkFormationCanTurn(formation, "angular_rate");
   } catch (const InvalidInput& e) {
@@ -48,7 +46,15 @@ CommandDesk::CommandDesk(const Scenario& scenario, const CommandLimits& limits)
   }
 }
 
+void CommandDesk::modeFrequencies() const {
+  if (softest_ >= 0.0) return;
+  const Formation formation = makeFormation(scenario_);
+  softest_ = minStiffnessFrequency(formation, formation.desiredShape());
+  stiffest_ = maxStiffnessFrequency(formation, formation.desiredShape());
+}
+
 std::string CommandDesk::turnNote(const Vector3& angularRate, double scale) const {
+  modeFrequencies();
   // As validateManoeuvre warns for a scenario's manoeuvre (doc/maths.md §9).
   const double allowed = 0.5 * scale * softest_;
   if (!(angularRate.norm() > allowed)) return "";
@@ -78,6 +84,7 @@ bool CommandDesk::acceptable(const Command& c, const std::string& field, std::st
     why = whyNoTurn_;
     return false;
   }
+  modeFrequencies();
   if (!isLinearlyStable(scenario_.timeStep, c.scale * stiffest_, scenario_.dampingGain)) {
     // The Hessian at the scaled shape is s^2 times the unscaled one: its frequencies grow as s.
     why = field + ": s = " + formatNumber(c.scale) + " puts h = " + formatNumber(scenario_.timeStep) +

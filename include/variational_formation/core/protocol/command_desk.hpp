@@ -103,7 +103,10 @@ class CommandDesk {
 
   Scenario scenario_;
   CommandLimits limits_;
-  double softest_ = 0.0, stiffest_ = 0.0;  // shape modes' frequencies at s = 1 [rad/s]
+  /// The shape modes' softest and stiffest frequencies at s = 1 [rad/s], computed at the first
+  /// command (an eigensolve of the Hessian: seconds for a thousand agents, none without commands).
+  void modeFrequencies() const;
+  mutable double softest_ = -1.0, stiffest_ = -1.0;
   long saturated_ = 0;
   bool canTurn_ = true;
   std::string whyNoTurn_;
