@@ -43,7 +43,8 @@ using variational_formation::RunProgress;
  * maths of the link (holonomic or unicycle hand point, odometry or integrated feedback) is
  * RobotLink's. It holds until the first odometry; refused odometry (NaN, a quaternion that is not
  * a rotation) is dropped, counted and warned about. At start it compares the robot's lag plus
- * one tick with the scenario's delay margin and warns if the lag exceeds it.
+ * one tick with the scenario's delay margin (checkRobotLag): a WARN if the lag exceeds it with
+ * odometry feedback, else one INFO line (with integrated feedback the margin does not bound it).
  *
  * Diagnostics on /diagnostics (diagnostic_updater, about 1 Hz): step rate, each neighbour's age,
  * accepted and dropped states, injected losses, held ticks; WARN while holding.
