@@ -120,7 +120,7 @@ TEST(SimulateSafety, ScatteredDeploymentsNeverComeCloserThanRAndReachTheShape) {
   }
 }
 
-// The same through the simulate CLI: the metrics' last column and the last line.
+// The same through the simulate CLI: the metrics' last column and the line before the shape verdict.
 TEST(SimulateSafety, SimulateWritesMinSeparationAndSaysWhenTheShapeFormed) {
   const std::string file = deploy(12, 2, true, true), metrics = tempPath("12_2.metrics.csv");
   const CliResult r = simulate({"--scenario", file, "--out", "/dev/null", "--metrics", metrics});
@@ -131,7 +131,7 @@ TEST(SimulateSafety, SimulateWritesMinSeparationAndSaysWhenTheShapeFormed) {
   std::ifstream in(metrics);
   std::string line;
   std::getline(in, line);
-  EXPECT_EQ(line, "step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error,min_separation");
+  EXPECT_EQ(line, "step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error,shape_error,min_separation");
   double closest = 1e9;
   long rows = 0;
   while (std::getline(in, line)) {
