@@ -2,9 +2,9 @@
 # `rosrun variational_formation simulate` finds them.
 add_library(variational_formation_tools
   src/tools/arguments.cpp
-  src/tools/simulate_cli.cpp
-  src/tools/scenario_info_cli.cpp
   src/tools/assign_slots_cli.cpp
+  src/tools/scenario_info_cli.cpp
+  src/tools/simulate_cli.cpp
 )
 target_link_libraries(variational_formation_tools PUBLIC variational_formation_core)
 # Scenario names (--scenario hexagon) are looked up without ROS too, beside the running program

@@ -74,12 +74,13 @@ TEST(SimulateManoeuvre, ScheduleAndItsCommandsFileGiveIdenticalOutput) {
   std::vector<double> x;
   std::istringstream fields(last);
   for (std::string f; std::getline(fields, f, ',');) x.push_back(std::stod(f));
-  ASSERT_EQ(x.size(), 17u);
+  ASSERT_EQ(x.size(), 18u);
   EXPECT_NEAR(x[10], -1.0, 1e-6);
   EXPECT_NEAR(x[11], 0.0, 1e-6);
   EXPECT_NEAR(x[15], 0.0, 1e-6);   // no rotation in the last segment
   EXPECT_NEAR(x[16], 0.0, 1e-6);   // scale 1.5 reached
   EXPECT_LT(x[3], 1e-5);           // edges at 1.5 d_ij
+  EXPECT_LT(x[17], 1e-4);          // and every pair: the shape is 1.5 q*
 }
 
 TEST(SimulateManoeuvre, OnlyWithTheVariationalMethodAndWithoutDelay) {
