@@ -1,15 +1,16 @@
 #include "variational_formation/core/shape_outcome.hpp"
 
 #include <cstdio>
+#include <limits>
 
 #include "variational_formation/core/procrustes.hpp"
 
 namespace vf {
 
 ShapeFindings findShape(const Formation& formation, const Positions& q, const Velocities& v, double scale,
-                        bool congruent, double tolerance, double maxSpeed) {
+                        bool congruent, double tolerance, double maxSpeed, bool withShapeError) {
   ShapeFindings f;
-  f.shapeError = formation.shapeError(q, scale);
+  f.shapeError = withShapeError ? formation.shapeError(q, scale) : std::numeric_limits<double>::quiet_NaN();
   f.maxEdgeError = formation.maxDistanceError(q, scale);
   f.congruent = congruent;
   f.edgesConverged = formation.allSlowerThan(v, maxSpeed) && formation.edgesWithin(q, tolerance, scale);

@@ -19,10 +19,11 @@ struct ShapeFindings {
  * The findings at one configuration q [m] with velocities v relative to the commanded motion
  * [m/s], against s d_ij (s = scale). `congruent` is the caller's congruence test (a
  * CongruenceTracker's, the same as congruenceSlack >= 0 with all speeds below maxSpeed). The
- * mirror test runs only on a congruent shape. O(n^2) for the shape error.
+ * mirror test runs only on a congruent shape. O(n^2) for the shape error, O(n + |E|) without it
+ * (withShapeError false: shapeError is NaN).
  */
 ShapeFindings findShape(const Formation& formation, const Positions& q, const Velocities& v, double scale,
-                        bool congruent, double tolerance, double maxSpeed);
+                        bool congruent, double tolerance, double maxSpeed, bool withShapeError = true);
 
 /// The three endings of a run.
 enum class ShapeVerdict { DesiredShape, OtherShape, NotConverged };
