@@ -15,11 +15,7 @@
 namespace vf {
 namespace {
 
-const std::string kConfig = std::string(VF_SOURCE_DIR) + "/config/";
-
-using test::CliResult;
-using test::simulate;
-using test::expectBadInput;
+using namespace test;  // NOLINT: the shared simulate helpers (simulate_test_support.hpp)
 
 std::string tempPath(const std::string& name) { return ::testing::TempDir() + "vf_manoeuvre_" + name; }
 
@@ -74,7 +70,7 @@ TEST(SimulateManoeuvre, ScheduleAndItsCommandsFileGiveIdenticalOutput) {
   std::vector<double> x;
   std::istringstream fields(last);
   for (std::string f; std::getline(fields, f, ',');) x.push_back(std::stod(f));
-  ASSERT_EQ(x.size(), 18u);
+  ASSERT_EQ(x.size(), 18u);  // the 17 columns and shape_error
   EXPECT_NEAR(x[10], -1.0, 1e-6);
   EXPECT_NEAR(x[11], 0.0, 1e-6);
   EXPECT_NEAR(x[15], 0.0, 1e-6);   // no rotation in the last segment
