@@ -131,15 +131,26 @@ bool faceCandidate(int d, const double* delta0, const HalfSpace* const* rows, in
 Projection projectDisplacement(int d, const double* delta0, const std::vector<HalfSpace>& constraints,
                                double maxStep) {
   Projection result;
+  projectDisplacement(d, delta0, constraints, maxStep, result);
+  return result;
+}
+
+void projectDisplacement(int d, const double* delta0, const std::vector<HalfSpace>& constraints, double maxStep,
+                         Projection& result) {
   const std::size_t m = constraints.size();
-  result.multipliers.assign(m, 0.0);
+  result.changed = false;
+  result.feasible = true;
+  result.multipliers.assign(m, 0.0);  // keeps the capacity: no allocation per step
+  result.speedMultiplier = 0.0;
+  result.active.clear();
+  result.speedLimited = false;
   const double norm0 = std::sqrt(dot(d, delta0, delta0));
   bool inside = norm0 <= maxStep;
   for (std::size_t i = 0; inside && i < m; ++i) {
     inside = dot(d, constraints[i].normal, delta0) >= constraints[i].bound;
   }
   for (int a = 0; a < d; ++a) result.delta[a] = delta0[a];
-  if (inside) return result;  // nothing binds: δ0 itself
+  if (inside) return;  // nothing binds: δ0 itself
   result.changed = true;
 
   // Only half-spaces that reach into |δ| <= min(|δ0|, ρ) can bind (margin for rounding).
@@ -202,7 +213,7 @@ Projection projectDisplacement(int d, const double* delta0, const std::vector<Ha
     // No face is feasible: with every b <= 0 only rounding can do that, and δ = 0 is safe.
     for (int a = 0; a < d; ++a) result.delta[a] = 0.0;
     for (std::size_t i = 0; i < m; ++i) result.feasible = result.feasible && constraints[i].bound <= 0.0;
-    return result;
+    return;
   }
   for (int a = 0; a < d; ++a) result.delta[a] = chosen.delta[a];
   for (int i = 0; i < chosenSize; ++i) {
@@ -235,7 +246,6 @@ Projection projectDisplacement(int d, const double* delta0, const std::vector<Ha
     if (!violated || !result.feasible) break;
     for (int a = 0; a < d; ++a) result.delta[a] *= pass < 3 ? t * (1.0 - 1e-12) : 0.0;
   }
-  return result;
 }
 
 void obstacleOffset(const Obstacle& o, int d, const double* q, double* w) {
@@ -285,22 +295,33 @@ void safetyConstraints(const SafetySettings& s, int d, const double* q, const st
   }
 }
 
+void filterDisplacement(const SafetySettings& s, double timeStep, int d, const double* q, const double* delta0,
+                        const std::vector<SensedAgent>& sensed, const std::vector<Obstacle>& obstacles, SafeStep& step) {
+  safetyConstraints(s, d, q, sensed, obstacles, step.constraints);
+  projectDisplacement(d, delta0, step.constraints, s.maxSpeed * timeStep, step.projection);
+}
+
 SafeStep filterDisplacement(const SafetySettings& s, double timeStep, int d, const double* q, const double* delta0,
                             const std::vector<SensedAgent>& sensed, const std::vector<Obstacle>& obstacles) {
   SafeStep step;
-  safetyConstraints(s, d, q, sensed, obstacles, step.constraints);
-  step.projection = projectDisplacement(d, delta0, step.constraints, s.maxSpeed * timeStep);
+  filterDisplacement(s, timeStep, d, q, delta0, sensed, obstacles, step);
   return step;
+}
+
+void filterNextPosition(const SafetySettings& s, double timeStep, int d, const double* q, double* qNext,
+                        const std::vector<SensedAgent>& sensed, const std::vector<Obstacle>& obstacles, SafeStep& step) {
+  double delta0[3] = {0.0, 0.0, 0.0};
+  for (int a = 0; a < d; ++a) delta0[a] = qNext[a] - q[a];
+  filterDisplacement(s, timeStep, d, q, delta0, sensed, obstacles, step);
+  if (step.projection.changed) {
+    for (int a = 0; a < d; ++a) qNext[a] = q[a] + step.projection.delta[a];
+  }
 }
 
 SafeStep filterNextPosition(const SafetySettings& s, double timeStep, int d, const double* q, double* qNext,
                             const std::vector<SensedAgent>& sensed, const std::vector<Obstacle>& obstacles) {
-  double delta0[3] = {0.0, 0.0, 0.0};
-  for (int a = 0; a < d; ++a) delta0[a] = qNext[a] - q[a];
-  SafeStep step = filterDisplacement(s, timeStep, d, q, delta0, sensed, obstacles);
-  if (step.projection.changed) {
-    for (int a = 0; a < d; ++a) qNext[a] = q[a] + step.projection.delta[a];
-  }
+  SafeStep step;
+  filterNextPosition(s, timeStep, d, q, qNext, sensed, obstacles, step);
   return step;
 }
 

@@ -13,11 +13,12 @@ void SafetyStage::sense(const Positions& q, long step) {
   if (sensedStep_ == step) return;
   sensedStep_ = step;
   grid_.build(q, settings_.sensingRadius);
+  grid_.neighbourLists(q, settings_.sensingRadius, sensedStart_, sensedIds_);
 }
 
 ClosestPair SafetyStage::closestPair(const Positions& q, long step) {
   sense(q, step);
-  const ClosestPair best = grid_.closestWithin(q, settings_.sensingRadius);
+  const ClosestPair best = closestListed(q, settings_.sensingRadius, sensedStart_, sensedIds_);
   if (best.first < 0) return vf::closestPair(q, 2.0 * settings_.sensingRadius);  // nobody within R
   return best;
 }
@@ -29,17 +30,15 @@ void SafetyStage::apply(const Positions& q, long step, Positions& qNext) {
   bindingObstacles_.clear();
   speedLimited_ = 0;
   for (int i = 0; i < q.cols(); ++i) {
-    near_.clear();
-    grid_.within(q, i, settings_.sensingRadius, near_);
     scratch_.clear();
-    for (int j : near_) {
+    for (int k = sensedStart_[static_cast<std::size_t>(i)]; k < sensedStart_[static_cast<std::size_t>(i) + 1]; ++k) {
       SensedAgent a;
-      a.id = j;
+      a.id = sensedIds_[static_cast<std::size_t>(k)];
       for (int c = 0; c < d; ++c) a.position[c] = q(c, a.id);
       scratch_.push_back(a);
     }
-    const SafeStep s =
-        filterNextPosition(settings_, timeStep_, d, q.col(i).data(), qNext.col(i).data(), scratch_, obstacles_);
+    SafeStep& s = step_;
+    filterNextPosition(settings_, timeStep_, d, q.col(i).data(), qNext.col(i).data(), scratch_, obstacles_, s);
     if (s.projection.speedLimited) ++speedLimited_;
     if (!s.projection.active.empty()) bindingAgents_.push_back(i);
     for (int m : s.projection.active) {

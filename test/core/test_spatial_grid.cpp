@@ -31,6 +31,7 @@ Positions randomPositions(std::mt19937_64& engine, int d, int n, double side) {
   return q;
 }
 
+// within() for one agent, and neighbourLists() for all at once.
 TEST(SpatialGrid, FindsExactlyTheAgentsWithinTheRadiusInAscendingId) {
   std::mt19937_64 engine(5);
   long found = 0;
@@ -46,11 +47,17 @@ TEST(SpatialGrid, FindsExactlyTheAgentsWithinTheRadiusInAscendingId) {
       SpatialGrid grid;
       grid.build(q, cell);
       for (double radius : {cell, 0.5 * cell}) {
+        std::vector<int> start, all;
+        grid.neighbourLists(q, radius, start, all);
+        ASSERT_EQ(start.size(), static_cast<std::size_t>(n) + 1);
         for (int i = 0; i < n; ++i) {
           std::vector<int> ids{-7};  // within() appends
           grid.within(q, i, radius, ids);
           ids.erase(ids.begin());
           ASSERT_EQ(ids, bruteForce(q, i, radius)) << "d " << d << " trial " << trial << " agent " << i;
+          const std::vector<int> listed(all.begin() + start[static_cast<std::size_t>(i)],
+                                        all.begin() + start[static_cast<std::size_t>(i) + 1]);
+          ASSERT_EQ(listed, ids) << "d " << d << " trial " << trial << " agent " << i;
           found += static_cast<long>(ids.size());
         }
       }
@@ -73,6 +80,10 @@ TEST(SpatialGrid, StaysExactFarOutAndSkipsNonFinitePositions) {
   std::vector<int> ids;
   grid.within(q, 0, 1.0, ids);
   EXPECT_EQ(ids, std::vector<int>{1});
+  std::vector<int> start, all;
+  grid.neighbourLists(q, 1.0, start, all);
+  EXPECT_EQ(start, (std::vector<int>{0, 1, 2, 3, 4, 4, 4}));
+  EXPECT_EQ(all, (std::vector<int>{1, 0, 3, 2}));
 }
 
 TEST(ClosestPair, AgreesWithBruteForce) {

@@ -44,6 +44,9 @@ struct Projection {
  */
 Projection projectDisplacement(int dimension, const double* delta0, const std::vector<HalfSpace>& constraints,
                                double maxStep);
+/// The same into `out`, reusing its storage (no allocation per call once it has grown).
+void projectDisplacement(int dimension, const double* delta0, const std::vector<HalfSpace>& constraints,
+                         double maxStep, Projection& out);
 
 /// Another agent as agent i senses it: its id and q_j^{k+1}.
 struct SensedAgent {
@@ -79,6 +82,10 @@ struct SafeStep {
 SafeStep filterDisplacement(const SafetySettings& settings, double timeStep, int dimension, const double* q,
                             const double* delta0, const std::vector<SensedAgent>& sensed,
                             const std::vector<Obstacle>& obstacles);
+/// The same into `out`, reusing its storage.
+void filterDisplacement(const SafetySettings& settings, double timeStep, int dimension, const double* q,
+                        const double* delta0, const std::vector<SensedAgent>& sensed,
+                        const std::vector<Obstacle>& obstacles, SafeStep& out);
 
 /**
  * Filters one agent's next position in place: qNext = q + δ when a constraint binds, and is left
@@ -88,5 +95,9 @@ SafeStep filterDisplacement(const SafetySettings& settings, double timeStep, int
 SafeStep filterNextPosition(const SafetySettings& settings, double timeStep, int dimension, const double* q,
                             double* qNext, const std::vector<SensedAgent>& sensed,
                             const std::vector<Obstacle>& obstacles);
+/// The same into `out`, reusing its storage.
+void filterNextPosition(const SafetySettings& settings, double timeStep, int dimension, const double* q,
+                        double* qNext, const std::vector<SensedAgent>& sensed, const std::vector<Obstacle>& obstacles,
+                        SafeStep& out);
 
 }  // namespace vf

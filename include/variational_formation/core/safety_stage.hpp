@@ -48,8 +48,9 @@ class SafetyStage {
   double timeStep_;
   SpatialGrid grid_;
   long sensedStep_ = -1;
-  std::vector<int> near_;  // whom the agent being filtered senses, ascending
+  std::vector<int> sensedStart_, sensedIds_;  // whom each agent senses at sensedStep_ (ascending)
   std::vector<SensedAgent> scratch_;
+  SafeStep step_;  // reused for every agent: no allocation per step
   std::vector<int> bindingAgents_, bindingObstacles_;
   int speedLimited_ = 0;
 };
