@@ -30,6 +30,9 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
   status.dropped = static_cast<uint32_t>(dropped_);
   status.max_data_age = dataAge;
   status.commands = static_cast<uint32_t>(commandsIssued());
+  // Not measured yet: NaN says so (FormationStatus.msg).
+  status.shape_error = std::numeric_limits<double>::quiet_NaN();
+  status.min_separation = std::numeric_limits<double>::quiet_NaN();
   if (!noetherHolds) {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     status.linear_momentum_predicted.x = status.linear_momentum_predicted.y = status.linear_momentum_predicted.z = nan;
