@@ -12,6 +12,7 @@ add_library(variational_formation_core
   src/core/explicit_integrators.cpp
   src/core/metrics.cpp
   src/core/stability.cpp
+  src/core/sparse_spectrum.cpp
   src/core/scenario.cpp
   src/core/validation.cpp
   src/core/simulation.cpp

@@ -6,13 +6,20 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "variational_formation/core/sparse_spectrum.hpp"
+
 namespace vf {
 
 double maxStiffnessFrequency(const Formation& formation, const Positions& q) {
   if (formation.edges().empty()) return 0.0;
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(formation.hessian(q),
-                                                        Eigen::EigenvaluesOnly);
-  const double lambda = solver.eigenvalues().maxCoeff();
+  double lambda = 0.0;
+  if (formation.dimension() * formation.agentCount() <= kDenseSpectrumLimit) {
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(formation.hessian(q), Eigen::EigenvaluesOnly);
+    lambda = solver.eigenvalues().maxCoeff();
+  } else {
+    // A dense eigensolver is O((n d)^3): 20 s at 1000 agents, at every load (doc/benchmarks.md).
+    lambda = largestEigenvalue(sparseHessian(formation, q));
+  }
   return lambda > 0.0 ? std::sqrt(lambda) : 0.0;
 }
 
