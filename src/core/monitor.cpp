@@ -118,10 +118,8 @@ FormationSnapshot FormationMonitor::measureStep(long step, const Positions& qPre
   s.positions = q;
   subtractCommandedMotion(command, q, v);  // from here on, relative to the commanded motion
   s.converged = congruence_.check(formation_, q, v, scale);
-  // The O(n^2) shape error at most as often as costs 200 agents' worth per step: every step up
-  // to 200 agents, every ceil((n/200)^2) steps beyond (NaN between), and at the last step.
-  const long every = static_cast<long>(std::ceil(std::pow(formation_.agentCount() / 200.0, 2)));
-  const bool measured = every <= 1 || step % every == 0 || (scenario_.steps > 0 && step == scenario_.steps);
+  // The O(n^2) shape error at most a 200-agent cost per step (NaN between).
+  const bool measured = shapeErrorMeasuredAt(step, formation_.agentCount(), scenario_.steps);
   s.shape = findShape(formation_, q, v, scale, s.converged, tolerance_, maxSpeed_, measured);
   if (!s.converged) {
     congruentSince_ = -1;

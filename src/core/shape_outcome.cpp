@@ -1,5 +1,6 @@
 #include "variational_formation/core/shape_outcome.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <limits>
 
@@ -18,6 +19,11 @@ ShapeFindings findShape(const Formation& formation, const Positions& q, const Ve
   // congruent: while it stays congruent this answer holds.
   f.mirrored = congruent && isMirrorImage(q, formation.desiredShape(), tolerance);
   return f;
+}
+
+bool shapeErrorMeasuredAt(long step, int agents, long lastStep) {
+  const long every = static_cast<long>(std::ceil(std::pow(agents / 200.0, 2)));
+  return every <= 1 || step % every == 0 || (lastStep > 0 && step == lastStep);
 }
 
 ShapeOutcome shapeOutcome(const ShapeFindings& findings, long congruentSince, bool mirrorAllowed, double timeStep) {

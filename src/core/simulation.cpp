@@ -1,6 +1,7 @@
 #include "variational_formation/core/simulation.hpp"
 
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <ostream>
 
@@ -13,7 +14,7 @@
 
 namespace vf {
 
-StepMetrics measure(const Integrator& integrator) {
+StepMetrics measure(const Integrator& integrator, bool withShapeError) {
   StepMetrics m;
   m.step = integrator.stepIndex();
   m.time = integrator.time();
@@ -27,7 +28,8 @@ StepMetrics measure(const Integrator& integrator) {
   m.centroidVelocity = centroidVelocity(v);
   m.rotationRate = rotationRate(integrator.positions(), v, integrator.timeStep());
   m.scaleError = meanScaleError(integrator.formation(), integrator.positions(), scale);
-  m.shapeError = integrator.formation().shapeError(integrator.positions(), scale);
+  m.shapeError = withShapeError ? integrator.formation().shapeError(integrator.positions(), scale)
+                                : std::numeric_limits<double>::quiet_NaN();
   if (SafetyStage* safety = integrator.safety()) {
     m.minSeparation = safety->closestPair(integrator.positions(), integrator.stepIndex()).distance;
   }

@@ -152,7 +152,10 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
       shape.observe(k, integrator.positions(), v, integrator.commandedScale());
       writeTrajectoryRows(traj, integrator.stepIndex(), integrator.time(),
                           integrator.positions());
-      if (withMetrics) writeMetricsRow(metrics, measure(integrator), safety);
+      if (withMetrics) {
+        writeMetricsRow(metrics, measure(integrator, shapeErrorMeasuredAt(k, formation.agentCount(), scenario.steps)),
+                        safety);
+      }
       if (divergedAt < 0 && !integrator.positions().allFinite()) {
         divergedAt = integrator.stepIndex();
       }

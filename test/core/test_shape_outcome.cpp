@@ -99,5 +99,17 @@ TEST(ShapeTracker, AgreesWithTheMonitorOnTheShippedHexagon) {
   EXPECT_LT(o.findings.shapeError, 0.01 * 3.0);
 }
 
+TEST(ShapeOutcome, TheAllPairsErrorCostsAtMostTwoHundredAgentsPerStep) {
+  for (long k = 0; k < 50; ++k) EXPECT_TRUE(shapeErrorMeasuredAt(k, 200, 0));
+  // 1000 agents: (1000/200)^2 = 25 times the pairs, measured every 25th step and at the last.
+  int measured = 0;
+  for (long k = 0; k <= 1000; ++k) measured += shapeErrorMeasuredAt(k, 1000, 990) ? 1 : 0;
+  EXPECT_EQ(measured, 41 + 1);  // 0, 25, ..., 1000, and 990
+  EXPECT_TRUE(shapeErrorMeasuredAt(990, 1000, 990));
+  EXPECT_FALSE(shapeErrorMeasuredAt(991, 1000, 990));
+  EXPECT_TRUE(shapeErrorMeasuredAt(50, 201, 0));  // ceil(1.01^2) = 2
+  EXPECT_FALSE(shapeErrorMeasuredAt(51, 201, 0));
+}
+
 }  // namespace
 }  // namespace vf

@@ -25,6 +25,13 @@ struct ShapeFindings {
 ShapeFindings findShape(const Formation& formation, const Positions& q, const Velocities& v, double scale,
                         bool congruent, double tolerance, double maxSpeed, bool withShapeError = true);
 
+/**
+ * Whether a run measures the O(n^2) shape error at `step`: at most a 200-agent cost per step on
+ * average, so every step up to 200 agents, every ceil((n/200)^2) steps beyond, and always at the
+ * last step (lastStep <= 0: unbounded). The monitor and `simulate`'s metrics use this one rule.
+ */
+bool shapeErrorMeasuredAt(long step, int agents, long lastStep);
+
 /// The three endings of a run.
 enum class ShapeVerdict { DesiredShape, OtherShape, NotConverged };
 

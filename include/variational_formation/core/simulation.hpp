@@ -31,7 +31,8 @@ struct StepMetrics {
 
 /// Energy, largest edge distance error (against s d_ij, s the commanded scale), momenta and
 /// tracking at the integrator's current step, and the closest pair if a safety filter is attached.
-StepMetrics measure(const Integrator& integrator);
+/// withShapeError false leaves shapeError NaN (the O(n^2) part; see shapeErrorMeasuredAt).
+StepMetrics measure(const Integrator& integrator, bool withShapeError = true);
 
 /**
  * Runs a validated scenario for scenario.steps updates, calling observe at steps 0..steps
