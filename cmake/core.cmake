@@ -6,6 +6,7 @@
 #catkin_lint: ignore_once unsorted_list
 add_library(variational_formation_core
   src/core/formation.cpp
+  src/core/force_model.cpp
   src/core/variational_update.cpp
   src/core/integrator.cpp
   src/core/variational_integrator.cpp

@@ -13,4 +13,8 @@ if(benchmark_FOUND)
   target_link_libraries(benchmark_roa variational_formation_core benchmark::benchmark)
   target_compile_options(benchmark_roa PRIVATE ${VF_FLAGS})
   target_compile_definitions(benchmark_roa PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  # One integrator step on a 1000-agent ring, no output (the force model's cost in simulate).
+  add_executable(benchmark_integrators benchmark/benchmark_integrators.cpp)
+  target_link_libraries(benchmark_integrators variational_formation_core benchmark::benchmark)
+  target_compile_options(benchmark_integrators PRIVATE ${VF_FLAGS})
 endif()

@@ -1,12 +1,14 @@
 # gtest unit tests: one file per core concept, run by `catkin_make run_tests`.
 if(CATKIN_ENABLE_TESTING)
-  set(VF_CORE_TESTS formation integrators metrics stability scenario free_particle lockstep simulation
+  set(VF_CORE_TESTS formation force_model integrators metrics stability scenario free_particle lockstep simulation
     timed_agent link_faults point_robot unicycle_robot record_ledger layers manoeuvre lockstep_manoeuvre monitor
     rigidity slot_assignment shape_outcome safety_filter spatial_grid safety_scenario blocked_detector
     sparse_spectrum)
   foreach(name ${VF_CORE_TESTS} command_desk)
     vf_add_gtest(test_${name} test/core/test_${name}.cpp variational_formation_core)
   endforeach()
+  # The layer guard reads what the built core library links (test_layers.cpp).
+  target_compile_definitions(test_layers PRIVATE VF_CORE_LIBRARY="$<TARGET_FILE:variational_formation_core>")
   # The protocol's event sequences and seeded interleavings, over shipped and generated formations
   # (test_command_desk above, and test_protocol, which generates formations with the tools).
   vf_add_gtest(test_protocol test/core/test_protocol.cpp variational_formation_tools)

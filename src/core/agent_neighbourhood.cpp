@@ -1,6 +1,7 @@
 #include "variational_formation/core/agent_neighbourhood.hpp"
 
 #include <cmath>
+#include <memory>
 #include <string>
 
 #include "variational_formation/core/error.hpp"
@@ -8,17 +9,18 @@
 namespace vf {
 
 AgentNeighbourhood::AgentNeighbourhood(const Scenario& scenario, int id)
-    : formation_(makeFormation(scenario)), id_(id) {
-  const int n = formation_.agentCount();
+    : model_(std::make_shared<const Formation>(makeFormation(scenario))), id_(id) {
+  const Formation& formation = model_.formation();
+  const int n = formation.agentCount();
   if (id < 0 || id >= n) {
     throw InvalidInput("id: must be an agent id 0.." + std::to_string(n - 1) + ", got " + std::to_string(id));
   }
-  const int d = formation_.dimension();
+  const int d = formation.dimension();
   q0_.assign(scenario.initialPositions.col(id).data(), scenario.initialPositions.col(id).data() + d);
   v0_.assign(scenario.initialVelocities.col(id).data(), scenario.initialVelocities.col(id).data() + d);
-  for (const Neighbour& nb : formation_.neighbours(id)) neighbourIds_.push_back(nb.agent);
+  for (const Neighbour& nb : formation.neighbours(id)) neighbourIds_.push_back(nb.agent);
   view_ = Positions::Zero(d, n);
-  motion_ = motionParameters(formation_, id);
+  motion_ = motionParameters(formation, id);
 }
 
 AgentNeighbourhood::StateCheck AgentNeighbourhood::check(long sender, const std::vector<double>& position,

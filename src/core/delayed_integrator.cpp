@@ -78,7 +78,7 @@ void DelayedVariationalIntegrator::step() {
       for (int a = 0; a < d; ++a) view_(a, nb.agent) = held[a];
       held += d;
     }
-    formation_.agentGradient(i, view_, g);
+    forces_.agentGradient(i, view_, g);
     variationalStep(coefficients_, start_, step_, d, qPrev_.col(i).data(), q_.col(i).data(),
                     v0_.col(i).data(), g, qNext_.col(i).data());
   }

@@ -14,7 +14,7 @@ double FirstOrderIntegrator::energy() const { return continuousEnergy(formation_
 // Paper eq. (formation3): v' = -kappa v - grad V(q).
 void FirstOrderIntegrator::acceleration(const Positions& q, const Velocities& v,
                                         Accelerations& out) const {
-  formation_.gradient(q, out);
+  forces_.gradient(q, out);
   out = -dampingGain_ * v - out;
 }
 

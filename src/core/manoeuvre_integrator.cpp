@@ -1,7 +1,6 @@
 #include "variational_formation/core/manoeuvre_integrator.hpp"
 
 #include "variational_formation/core/metrics.hpp"
-#include "variational_formation/core/safety_stage.hpp"
 
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/validation.hpp"
@@ -31,7 +30,7 @@ ManoeuvreIntegrator::ManoeuvreIntegrator(const Formation& formation, const Posit
 void ManoeuvreIntegrator::forcing(const ManoeuvreGains& g, int agent, const Positions& q, double* out) const {
   const int d = formation_.dimension();
   double r[3] = {0.0, 0.0, 0.0};
-  if (g.rotates) centroidOffset(formation_, parameters_[static_cast<std::size_t>(agent)], agent, q, r);
+  if (g.rotates) forces_.centroidOffset(parameters_[static_cast<std::size_t>(agent)], agent, q, r);
   for (int a = 0; a < d; ++a) out[a] = manoeuvreForcing(g, d, a, r);
 }
 
@@ -41,8 +40,8 @@ void ManoeuvreIntegrator::step() {
   const ManoeuvreGains g = model_.updateGains(step_);
   double gradient[3], offset[3] = {0.0, 0.0, 0.0};
   for (int i = 0; i < n; ++i) {
-    formation_.agentScaledGradient(i, q_, g.scaleSquared, gradient);
-    if (g.rotates) centroidOffset(formation_, parameters_[static_cast<std::size_t>(i)], i, q_, offset);
+    forces_.agentGradient(i, q_, g.scaleSquared, gradient);
+    if (g.rotates) forces_.centroidOffset(parameters_[static_cast<std::size_t>(i)], i, q_, offset);
     double* next = qNext_.col(i).data();
     if (step_ > 0) {
       // doc/maths.md §9, the forced update.
@@ -53,7 +52,7 @@ void ManoeuvreIntegrator::step() {
       paperStart(coefficients_, d, q_.col(i).data(), v0_.col(i).data(), next);
     }
   }
-  if (safety_) safety_->apply(q_, step_, qNext_);  // doc/maths.md §10, after every agent's update
+  forces_.filterStep(q_, step_, qNext_);  // doc/maths.md §10, after every agent's update
   qPrev_.swap(q_);
   q_.swap(qNext_);
   ++step_;
@@ -71,7 +70,7 @@ Momenta ManoeuvreIntegrator::momenta() const {
   Momenta p(d, formation_.agentCount());
   double gradient[3], f[3];
   for (int i = 0; i < formation_.agentCount(); ++i) {
-    formation_.agentScaledGradient(i, q_, g.scaleSquared, gradient);
+    forces_.agentGradient(i, q_, g.scaleSquared, gradient);
     forcing(g, i, q_, f);
     for (int a = 0; a < d; ++a) {
       const double v = (q_(a, i) - qPrev_(a, i)) / timeStep_;

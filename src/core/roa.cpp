@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <string>
 
 #include "variational_formation/core/error.hpp"
@@ -12,7 +13,8 @@
 namespace vf {
 
 RoaCampaign::RoaCampaign(const Scenario& scenario, const RoaGrid& grid, const RoaSettings& settings)
-    : formation_(makeFormation(scenario)),
+    : model_(std::make_shared<const Formation>(makeFormation(scenario))),
+      formation_(model_.formation()),
       grid_(grid),
       settings_(settings),
       coefficients_(settings.timeStep, settings.dampingGain) {
@@ -81,6 +83,7 @@ RoaCell RoaCampaign::simulateCell(int cell) const {
   const Positions q0 = initialPositions(cell);
   VariationalIntegrator vi(formation_, q0, Positions::Zero(q0.rows(), q0.cols()),
                            settings_.timeStep, settings_.dampingGain, StartMethod::Variational);
+  vi.forceModel() = model_;  // the batched path's forces
   long lastIncongruent = -1;
   bool congruent = false;
   for (long k = 0; k <= settings_.steps; ++k) {
@@ -102,6 +105,7 @@ Positions RoaCampaign::finalPositionsOfCell(int cell) const {
   const Positions q0 = initialPositions(cell);
   VariationalIntegrator vi(formation_, q0, Positions::Zero(q0.rows(), q0.cols()),
                            settings_.timeStep, settings_.dampingGain, StartMethod::Variational);
+  vi.forceModel() = model_;
   for (long k = 0; k < settings_.steps; ++k) vi.step();
   return vi.positions();
 }
@@ -138,38 +142,6 @@ struct LaneState {
   bool diverged[kLanes];
   bool congruent[kLanes];
 };
-
-// gradient = grad V(q_k), scattered edge by edge as Formation::agentGradient gathers it: agent
-// j's terms arrive in the order of its neighbour list, and gamma (q_j - q_i) = -(gamma (q_i - q_j))
-// exactly.
-void accumulateGradient(const std::vector<Edge>& edges, LaneState& s) {
-  const int d = s.dimension;
-  double* const g = s.gradient;
-  const double* const q = s.q;
-  std::fill(g, g + s.stride, 0.0);
-  for (const Edge& e : edges) {
-    double* gi = g + e.tail * d * kLanes;
-    double* gj = g + e.head * d * kLanes;
-    const double* qi = q + e.tail * d * kLanes;
-    const double* qj = q + e.head * d * kLanes;
-    double gamma[kLanes];
-    for (int l = 0; l < kLanes; ++l) gamma[l] = 0.0;
-    for (int a = 0; a < d; ++a) {
-      for (int l = 0; l < kLanes; ++l) {
-        const double diff = qi[a * kLanes + l] - qj[a * kLanes + l];
-        gamma[l] += diff * diff;
-      }
-    }
-    for (int l = 0; l < kLanes; ++l) gamma[l] -= e.desiredDistanceSquared;
-    for (int a = 0; a < d; ++a) {
-      for (int l = 0; l < kLanes; ++l) {
-        const double term = gamma[l] * (qi[a * kLanes + l] - qj[a * kLanes + l]);
-        gi[a * kLanes + l] += term;
-        gj[a * kLanes + l] -= term;
-      }
-    }
-  }
-}
 
 // q_{k+1} from q_k (and q_{k-1}) with the operations of variationalStart (k = 0, v_0 = 0) and
 // variationalUpdate, then shifts the window so that q holds step k + 1.
@@ -286,7 +258,7 @@ void RoaCampaign::simulateBatch(int first, int count, RoaCell* out,
   }
   for (long k = 0; k <= settings_.steps; ++k) {
     if (k > 0) {
-      accumulateGradient(formation_.edges(), lanes);
+      model_.laneGradient<kLanes>(lanes.q, lanes.gradient);  // grad V(q_k), the force model's fast path
       advance(coefficients_, k - 1, lanes);
     }
     if (markDiverged(settings_.divergenceBound, lanes)) break;

@@ -1,7 +1,6 @@
 #include "variational_formation/core/variational_integrator.hpp"
 
 #include "variational_formation/core/metrics.hpp"
-#include "variational_formation/core/safety_stage.hpp"
 
 namespace vf {
 
@@ -22,11 +21,11 @@ void VariationalIntegrator::step() {
   const int n = formation_.agentCount();
   for (int i = 0; i < n; ++i) {
     double* g = gradient_.col(i).data();
-    formation_.agentGradient(i, q_, g);
+    forces_.agentGradient(i, q_, g);
     variationalStep(coefficients_, start_, step_, d, qPrev_.col(i).data(), q_.col(i).data(),
                     v0_.col(i).data(), g, qNext_.col(i).data());
   }
-  if (safety_) safety_->apply(q_, step_, qNext_);  // doc/maths.md §10, after every agent's update
+  forces_.filterStep(q_, step_, qNext_);  // doc/maths.md §10, after every agent's update
   qPrev_.swap(q_);
   q_.swap(qNext_);
   ++step_;

@@ -2,6 +2,7 @@
 
 #include <vector>
 
+#include "variational_formation/core/force_model.hpp"
 #include "variational_formation/core/motion_parameters.hpp"
 #include "variational_formation/core/scenario.hpp"
 
@@ -10,7 +11,8 @@ namespace vf {
 /**
  * What one agent of a distributed run knows of the formation (doc/distributed.md): its initial state,
  * its neighbours, the checks of a neighbour's state message, and grad_i V from the positions it
- * holds, through Formation::agentGradient exactly as the centralised integrators call it.
+ * holds, through the force model (ForceModel::agentGradient) exactly as the centralised
+ * integrators call it.
  */
 class AgentNeighbourhood {
  public:
@@ -21,7 +23,9 @@ class AgentNeighbourhood {
   AgentNeighbourhood(const Scenario& scenario, int id);
 
   int id() const { return id_; }
-  int dimension() const { return formation_.dimension(); }
+  int dimension() const { return model_.dimension(); }
+  /// What acts on this agent (the formation potential; its neighbours' positions are all it reads).
+  const ForceModel& forceModel() const { return model_; }
   /// N_i in the order of the scenario's edges.
   const std::vector<int>& neighbourIds() const { return neighbourIds_; }
   /// q_0 and v_0 of the scenario [m], [m/s].
@@ -40,7 +44,7 @@ class AgentNeighbourhood {
   template <class NeighbourPosition>
   void gradient(const double* own, NeighbourPosition neighbourPosition, double* out) {
     view(own, neighbourPosition);
-    formation_.agentGradient(id_, view_, out);
+    model_.agentGradient(id_, view_, out);
   }
 
   /**
@@ -52,8 +56,8 @@ class AgentNeighbourhood {
   void forcedGradient(const double* own, NeighbourPosition neighbourPosition, double scaleSquared, bool rotates,
                       double* gradient, double* offset) {
     view(own, neighbourPosition);
-    formation_.agentScaledGradient(id_, view_, scaleSquared, gradient);
-    if (rotates) centroidOffset(formation_, motion_, id_, view_, offset);
+    model_.agentGradient(id_, view_, scaleSquared, gradient);
+    if (rotates) model_.centroidOffset(motion_, id_, view_, offset);
   }
   /// Whether this agent knows its offset from the centroid from its neighbours (it can turn),
   /// and if not, why.
@@ -71,7 +75,7 @@ class AgentNeighbourhood {
     }
   }
 
-  Formation formation_;
+  ForceModel model_;  // owns the scenario's formation: agents are moved into vectors
   int id_;
   std::vector<int> neighbourIds_;
   std::vector<double> q0_, v0_;

@@ -4,6 +4,7 @@
 #include <string>
 #include <utility>
 
+#include "variational_formation/core/force_model.hpp"
 #include "variational_formation/core/formation.hpp"
 #include "variational_formation/core/variational_update.hpp"
 
@@ -42,12 +43,17 @@ class Integrator {
   virtual double commandedScale() const { return 1.0; }
 
   /**
-   * Sends every later step through the safety filter (doc/maths.md §10). Only the variational
-   * integrators (plain and under commands) apply it; without one, today's steps bit for bit.
+   * Sends every later step through the safety filter (doc/maths.md §10): the force model's step
+   * filter. Only the variational integrators (plain and under commands) apply it; without one,
+   * today's steps bit for bit.
    */
-  void attachSafety(std::shared_ptr<SafetyStage> stage) { safety_ = std::move(stage); }
+  void attachSafety(std::shared_ptr<SafetyStage> stage) { forces_.setStepFilter(std::move(stage)); }
   /// The attached filter, or nullptr.
-  SafetyStage* safety() const { return safety_.get(); }
+  SafetyStage* safety() const { return forces_.stepFilter(); }
+
+  /// What acts on the agents (force_model.hpp): the formation potential, added terms, the filter.
+  ForceModel& forceModel() { return forces_; }
+  const ForceModel& forceModel() const { return forces_; }
 
   long stepIndex() const { return step_; }
   double time() const { return static_cast<double>(step_) * timeStep_; }
@@ -56,13 +62,13 @@ class Integrator {
 
  protected:
   Integrator(const Formation& formation, double timeStep, double dampingGain)
-      : formation_(formation), timeStep_(timeStep), dampingGain_(dampingGain) {}
+      : formation_(formation), forces_(formation), timeStep_(timeStep), dampingGain_(dampingGain) {}
 
   const Formation& formation_;
+  ForceModel forces_;  // every step's forces go through it
   double timeStep_;
   double dampingGain_;
   long step_ = 0;
-  std::shared_ptr<SafetyStage> safety_;
 };
 
 /**

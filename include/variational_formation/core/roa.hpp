@@ -4,6 +4,7 @@
 #include <functional>
 #include <vector>
 
+#include "variational_formation/core/force_model.hpp"
 #include "variational_formation/core/scenario.hpp"
 #include "variational_formation/core/variational_update.hpp"
 
@@ -48,7 +49,9 @@ struct RoaCell {
  * Two paths compute the same thing: simulateCell (one simulation over the core's
  * VariationalIntegrator and Formation::isCongruent) and the batched kernel that run() uses
  * (kLanes simulations side by side, structure of arrays, the same operations in the same
- * order), whose positions are bit-identical to the scalar path.
+ * order), whose positions are bit-identical to the scalar path. Both take their forces from one
+ * ForceModel: the scalar path through the integrator, the batched one through its fast path
+ * ForceModel::laneGradient.
  */
 class RoaCampaign {
  public:
@@ -60,6 +63,7 @@ class RoaCampaign {
 
   int cellCount() const { return grid_.nx * grid_.ny; }
   const Formation& formation() const { return formation_; }
+  const ForceModel& forceModel() const { return model_; }
 
   /// Runs every cell on `threads` threads (results do not depend on the thread count).
   /// @param progress called from the calling thread about every 100 ms with cells done.
@@ -78,7 +82,8 @@ class RoaCampaign {
   RoaCell cellAt(int cell) const;
   Positions initialPositions(int cell) const;
 
-  Formation formation_;
+  ForceModel model_;  // owns the scenario's formation
+  const Formation& formation_;
   RoaGrid grid_;
   RoaSettings settings_;
   VariationalCoefficients coefficients_;
