@@ -38,6 +38,7 @@ add_library(variational_formation_core
   src/core/hungarian.cpp
   src/core/slot_assignment.cpp
   src/core/shape_outcome.cpp
+  src/core/goal_steering.cpp
   src/core/spatial_grid.cpp
   src/core/safety_filter.cpp
   src/core/safety_validation.cpp

@@ -10,6 +10,7 @@ target_sources(variational_formation_ros PRIVATE src/ros/timed_agent_node.cpp sr
 # The monitor's two modes over its shared wiring, and the bounded pool of service calls.
 target_sources(variational_formation_ros PRIVATE src/ros/lockstep_monitor.cpp src/ros/monitor_commands.cpp
   src/ros/monitor_parameters.cpp src/ros/timed_monitor.cpp src/ros/monitor_outputs.cpp
+  src/ros/monitor_shape.cpp src/ros/monitor_goals.cpp src/ros/goal_server.cpp
   src/ros/recorder_bag.cpp src/ros/recorder_commands.cpp
   src/ros/service_call.cpp src/ros/state_batch.cpp src/ros/periodic_call.cpp)
 add_dependencies(variational_formation_ros ${PROJECT_NAME}_gencfg)
@@ -77,6 +78,8 @@ if(CATKIN_ENABLE_TESTING)
   # an agent and the monitor killed during the manoeuvre.
   add_rostest(test/ros/manoeuvre_run.test ARGS case:=live seed:=3)
   add_rostest(test/ros/manoeuvre_run.test ARGS case:=faults seed:=5 faults:=true)
+  # Goals (move_to, /move_base_simple/goal) in a recorded lockstep run (test/ros/goal.test).
+  add_rostest(test/ros/goal.test)
   # The bounded pool of service calls (no master).
   catkin_add_gtest(test_call_pool test/ros/test_call_pool.cpp)
   target_include_directories(test_call_pool SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})

@@ -48,6 +48,7 @@ case "$outcome" in
   succeeded|stopped)
     case "$formation" in
       "not converged"*) echo "run_formation: the run $outcome, but the formation did not converge: ${formation#not converged }" >&2 ;;
+      "edges converged"*) echo "run_formation: the run $outcome, but the formation is not in the desired shape: $formation" >&2 ;;
     esac
     exit 0 ;;
   *) echo "run_formation: the run $outcome: $(sed -n 's/^reason: //p' "$result" | tr -d '"')" >&2; exit 1 ;;

@@ -45,4 +45,16 @@ RunVerdict finishedRunVerdict(const Scenario& scenario, const FormationOutcome& 
   return v;
 }
 
+RunVerdict finishedRunVerdict(const Scenario& scenario, const ShapeOutcome& shape) {
+  if (shape.verdict == ShapeVerdict::NotConverged) {
+    return finishedRunVerdict(scenario, formationOutcome(-1, shape.findings.maxEdgeError, scenario.timeStep));
+  }
+  RunVerdict v;
+  if (scenario.requireConvergence && shape.verdict != ShapeVerdict::DesiredShape) {
+    v.succeeded = false;
+    v.reason = "the formation did not reach the desired shape, and the scenario requires it (require_convergence: true)";
+  }
+  return v;
+}
+
 }  // namespace vf

@@ -78,6 +78,7 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh, bool timed) 
   progress_.allowed_step = 0;
   progress_.converged_step = -1;
   setUpCommands(nh, pnh);
+  setUpGoals(nh, pnh);
   setUpParameters(nh, timed);
 }
 

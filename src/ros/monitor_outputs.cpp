@@ -30,8 +30,9 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
   status.dropped = static_cast<uint32_t>(dropped_);
   status.max_data_age = dataAge;
   status.commands = static_cast<uint32_t>(commandsIssued());
+  status.shape_error = s.shape.shapeError;  // NaN at steps it skips (FormationSnapshot::shape)
+  noteShape(s);
   // Not measured yet: NaN says so (FormationStatus.msg).
-  status.shape_error = std::numeric_limits<double>::quiet_NaN();
   status.min_separation = std::numeric_limits<double>::quiet_NaN();
   if (!noetherHolds) {
     const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -40,6 +41,7 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
     status.angular_momentum_predicted.z = nan;
   }
   statusPub_.publish(status);
+  goals_->onStep(s.metrics.step, s.positions, s.converged, s.metrics.maxDistanceError, stamp);
   // Never backwards: with several formations on one master, the one furthest ahead sets it.
   if (publishClock_ && (!ros::Time::isSimTime() || stamp >= ros::Time::now())) {
     rosgraph_msgs::Clock clock;
@@ -77,9 +79,10 @@ void MonitorNode::writeResult(const std::string& result, const std::string& reas
   std::ofstream f(resultFile_);
   std::string quoted;
   for (char c : reason) quoted += c == '"' ? std::string("\\\"") : std::string(1, c);
-  const FormationOutcome formation = formationOutcome(convergedStep_, finalError_, scenario_.timeStep);
+  const ShapeOutcome formation = shapeVerdict();
   f << "result: " << result << "\nscenario: " << scenario_.name << "\nsteps: " << scenario_.steps
-    << "\ncompleted_step: " << completedStep() << "\nconverged_step: " << convergedStep_ << "\nformation: \""
+    << "\ncompleted_step: " << completedStep() << "\nconverged_step: " << formation.convergedStep
+    << "\nshape_error: " << formation.findings.shapeError << "\nformation: \""
     << formation.line << "\"\nfinal_max_distance_error: " << finalError_ << "\ndropped: " << dropped_ << "\ncommands: " << commandsIssued()
     << "\ncommands_refused: " << commandsRefused_ << "\ncommands_saturated: " << desk_->saturated()
     << "\nreason: \"" << quoted << "\"\n";
@@ -89,8 +92,9 @@ void MonitorNode::writeResult(const std::string& result, const std::string& reas
 void MonitorNode::finish(uint8_t state, std::string reason) {
   if (ended()) return;
   const long last = completedStep();
+  goals_->end("the run ended at step " + std::to_string(last));
   const double h = scenario_.timeStep;
-  const FormationOutcome formation = formationOutcome(convergedStep_, finalError_, h);
+  const ShapeOutcome formation = shapeVerdict();
   const RunVerdict verdict = finishedRunVerdict(scenario_, formation);
   if (state == RunProgress::FINISHED) {
     const double seconds = (ros::WallTime::now() - firstStepAt_).toSec();

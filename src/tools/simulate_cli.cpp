@@ -181,12 +181,10 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
     const ShapeOutcome outcome = shape.outcome(scenario.timeStep);
     out << "formation: " << outcome.line << '\n';
     if (safetyStatus != kExitOk) return safetyStatus;
-    if (scenario.requireConvergence && outcome.verdict != ShapeVerdict::DesiredShape) {
-      err << "simulate: error: the formation did not reach the desired shape, and the scenario requires it "
-             "(require_convergence: true)\n";
-      return kExitFailure;
-    }
-    return kExitOk;
+    const RunVerdict verdict = finishedRunVerdict(scenario, outcome);
+    if (verdict.succeeded) return kExitOk;
+    err << "simulate: error: " << verdict.reason << '\n';
+    return kExitFailure;
   } catch (const InvalidInput& e) {
     err << "simulate: error: " << e.what() << '\n';
     return kExitBadInput;

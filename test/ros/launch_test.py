@@ -115,8 +115,9 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
         with open(os.path.join(self.tmp, SCENARIO + ".result.yaml")) as f:
             done = yaml.safe_load(f)
         self.assertEqual(done["result"], "succeeded")
-        self.assertRegex(done["formation"], r"^converged at step \d+ \(t = [0-9.]+ s\)$")
-        self.assertEqual(int(done["formation"].split()[3]), done["converged_step"])
+        self.assertRegex(done["formation"], r"^converged to the desired shape at step \d+ \(t = [0-9.]+ s\)$")
+        self.assertEqual(int(done["formation"].split()[7]), done["converged_step"])
+        self.assertLess(done["shape_error"], 0.01 * 3.0)  # every pair within 1 % (the hexagon's side is 3 m)
         for name, strict in (("short", False), ("short_strict", True)):
             fields = dict(steps=20, require_convergence=True) if strict else dict(steps=20)
             path = self.scenario_variant(name, **fields)

@@ -193,6 +193,12 @@ class RunChecks:
         self.assertEqual([k for k, msgs in rec.status.items() if len(msgs) != 1], [], "statuses recorded twice")
         self.assertEqual(rec.out_of_order[:5], [], f"{len(rec.out_of_order)} messages out of time order")
 
+    def check_equals_simulate(self, rec, scenario, expected):
+        """Every (agent, step) once, and each position equal to `expected` (simulate's) bit for bit."""
+        self.check_each_step_once(rec, scenario["n"], int(scenario["steps"]))
+        differ = sorted(key for key, msgs in rec.states.items() if any(list(m.position) != expected[key] for m in msgs))
+        self.assertEqual(differ[:5], [], f"{len(differ)} recorded states differ from simulate")
+
     def check_recording(self, rec, scenario, expected, ns="/formation"):
         n, steps, h = scenario["n"], int(scenario["steps"]), float(scenario["time_step"])
         self.check_each_step_once(rec, n, steps)

@@ -56,6 +56,28 @@ TEST(ScenarioInfo, SaysTheRigidityClassAndWarnsUnlessGloballyRigid) {
   EXPECT_EQ(ring.err.find("warning"), std::string::npos) << ring.err;
 }
 
+// The shipped deployment: scattered starts, a globally rigid graph (its comment says so, and
+// scenario_info), the safety filter; it must reach the desired shape in simulate, no two agents
+// closer than the filter's radius.
+TEST(HexagonDeploy, IsGloballyRigidAndReachesTheDesiredShapeWithAgentsApart) {
+  std::ifstream file(kConfig + "hexagon_deploy.yaml");
+  std::stringstream text;
+  text << file.rdbuf();
+  EXPECT_NE(text.str().find("globally rigid in 2D"), std::string::npos);
+  const Scenario s = loadScenario(kConfig + "hexagon_deploy.yaml");
+  ASSERT_TRUE(s.safety.has_value());
+  EXPECT_EQ(classifyRigidity(makeFormation(s)).rigidityClass, RigidityClass::GloballyRigid);
+  const CliResult info = run(runScenarioInfoCli, {"--scenario", kConfig + "hexagon_deploy.yaml"});
+  EXPECT_EQ(info.status, 0);
+  EXPECT_EQ(info.err.find("warning"), std::string::npos) << info.err;
+  const CliResult r = run(runSimulateCli, {"--scenario", kConfig + "hexagon_deploy.yaml", "--out", "/dev/null"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(lastLine(r.out).rfind("formation: converged to the desired shape at step ", 0), 0u) << r.out;
+  const std::size_t at = r.out.find("closest approach ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  EXPECT_GE(std::stod(r.out.substr(at + 17)), s.safety->radius * (1.0 - 1e-9)) << r.out;
+}
+
 Scenario generated(const std::vector<std::string>& flags, const std::string& file, std::string* comments = nullptr) {
   std::vector<std::string> args = flags;
   args.insert(args.end(), {"--out", tempPath(file)});

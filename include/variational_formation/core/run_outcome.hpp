@@ -3,6 +3,7 @@
 #include <string>
 
 #include "variational_formation/core/scenario.hpp"
+#include "variational_formation/core/shape_outcome.hpp"
 
 namespace vf {
 
@@ -35,5 +36,8 @@ struct RunVerdict {
   std::string reason;  ///< why it failed (one line), empty if it succeeded
 };
 RunVerdict finishedRunVerdict(const Scenario& scenario, const FormationOutcome& formation);
+/// The same from a run's shape (`simulate`'s and the monitor's final line): converged means the
+/// desired shape; a folded one fails a scenario with `require_convergence: true` too.
+RunVerdict finishedRunVerdict(const Scenario& scenario, const ShapeOutcome& shape);
 
 }  // namespace vf

@@ -22,6 +22,7 @@
 #include "variational_formation/core/protocol/command_desk.hpp"
 #include "variational_formation/core/protocol/run_referee.hpp"
 #include "variational_formation/core/protocol/timed_referee.hpp"
+#include "variational_formation/ros/goal_server.hpp"
 #include "variational_formation/ros/service_call.hpp"
 #include "variational_formation/ros/state_batch.hpp"
 
@@ -105,6 +106,10 @@ class MonitorNode {
   /// The issued list on `command`, stamped as the mode stamps what it says (stampOf).
   void publishCommands();
 
+  // Goals (src/ros/monitor_goals.cpp): move_to and move_base_simple/goal, steered through desk_.
+  void setUpGoals(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  std::unique_ptr<GoalServer> goals_;
+
   // The formation's kappa (src/ros/monitor_parameters.cpp, doc/ros_api.md "monitor"): a
   // dynamic_reconfigure server in the formation's namespace, whose latched parameter_updates the
   // timed agents follow. Lockstep (`timed` false) refuses any change.
@@ -155,6 +160,11 @@ class MonitorNode {
   bool kappaFixed_ = false;  // lockstep: the scenario's, for good
   std::string kappaName_;    // its parameter, resolved (/formation/kappa)
 
+  // The run's shape (src/ros/monitor_shape.cpp): the newest step's findings and the verdict
+  // that `simulate` gives too (shapeOutcome), for the result file and the last line.
+  void noteShape(const FormationSnapshot& s);
+  ShapeOutcome shapeVerdict() const;
+
  private:
   void writeResult(const std::string& result, const std::string& reason) const;
   void onAgentTopic(int agent, const ros::MessageEvent<AgentState const>& event);
@@ -172,6 +182,9 @@ class MonitorNode {
   long markerEvery_ = 1;
   std::string resultFile_;
   double finalError_ = 0.0;  // max distance error at the last completed step [m]
+  ShapeFindings lastShape_;  // at the newest completed step (noteShape)
+  Positions lastPositions_;
+  double lastScale_ = 1.0;
   int exitStatus_ = -1;
 };
 

@@ -1,0 +1,25 @@
+// The run's shape as the monitor reports it (MonitorNode, monitor_node.hpp): the findings of the
+// newest completed step, and at the end the verdict `simulate` gives too (core shapeOutcome):
+// the desired shape, another shape with every edge right, or not converged.
+#include <cmath>
+
+#include "variational_formation/ros/monitor_node.hpp"
+
+namespace vf {
+
+void MonitorNode::noteShape(const FormationSnapshot& s) {
+  lastShape_ = s.shape;
+  lastPositions_ = s.positions;
+  lastScale_ = s.scale;
+}
+
+ShapeOutcome MonitorNode::shapeVerdict() const {
+  ShapeFindings f = lastShape_;
+  // Beyond 200 agents the shape error skips steps (FormationSnapshot::shape): the verdict needs it.
+  if (std::isnan(f.shapeError) && lastPositions_.size() > 0) {
+    f.shapeError = measure().formation().shapeError(lastPositions_, lastScale_);
+  }
+  return shapeOutcome(f, convergedStep_, scenario_.mirrorAllowed, scenario_.timeStep);
+}
+
+}  // namespace vf
