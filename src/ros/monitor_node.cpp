@@ -78,6 +78,7 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh, bool timed) 
   progress_.allowed_step = 0;
   progress_.converged_step = -1;
   setUpCommands(nh, pnh);
+  setUpSafety(pnh, timed);
   setUpParameters(nh, timed);
 }
 
@@ -126,7 +127,9 @@ bool MonitorNode::admit(int agent, const AgentState& msg, const std::string& pub
     finish(RunProgress::FAILED, agents_[static_cast<std::size_t>(agent)].node + ": " + msg.failure);
     return false;
   }
-  return offer(agent, msg, publisher);
+  if (!offer(agent, msg, publisher)) return false;
+  noteSafety(agent, msg);
+  return true;
 }
 
 void MonitorNode::heard(int agent, const std::string& publisher) {

@@ -33,6 +33,7 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
   // Not measured yet: NaN says so (FormationStatus.msg).
   status.shape_error = std::numeric_limits<double>::quiet_NaN();
   status.min_separation = std::numeric_limits<double>::quiet_NaN();
+  const bool blocked = watchSafety(s, status);
   if (!noetherHolds) {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     status.linear_momentum_predicted.x = status.linear_momentum_predicted.y = status.linear_momentum_predicted.z = nan;
@@ -53,6 +54,7 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
   const bool edge = s.metrics.step == 0 || (last > 0 && s.metrics.step == last);
   if (edge || (s.metrics.step % markerEvery_ == 0 && (recording_ || markersPub_.getNumSubscribers() > 0))) {
     out.second = makeMarkers(s, measure().formation(), trails_, commandSchedule(), scenario_.timeStep);
+    if (scenario_.safety) addSafetyMarkers(s, *scenario_.safety, scenario_.obstacles, out.second);
     for (auto& m : out.second.markers) {
       m.header.stamp = stamp;
       m.header.frame_id = worldFrame_;
@@ -69,6 +71,7 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
     ROS_INFO("monitor: left the desired shape at step %ld", s.metrics.step);
     reportedConvergence_ = -2;
   }
+  if (blocked) finish(RunProgress::FINISHED, "");  // the formation cannot form: say so instead of running on
   return out;
 }
 
@@ -77,12 +80,12 @@ void MonitorNode::writeResult(const std::string& result, const std::string& reas
   std::ofstream f(resultFile_);
   std::string quoted;
   for (char c : reason) quoted += c == '"' ? std::string("\\\"") : std::string(1, c);
-  const FormationOutcome formation = formationOutcome(convergedStep_, finalError_, scenario_.timeStep);
+  const FormationOutcome formation = outcome();
   f << "result: " << result << "\nscenario: " << scenario_.name << "\nsteps: " << scenario_.steps
     << "\ncompleted_step: " << completedStep() << "\nconverged_step: " << convergedStep_ << "\nformation: \""
     << formation.line << "\"\nfinal_max_distance_error: " << finalError_ << "\ndropped: " << dropped_ << "\ncommands: " << commandsIssued()
     << "\ncommands_refused: " << commandsRefused_ << "\ncommands_saturated: " << desk_->saturated()
-    << "\nreason: \"" << quoted << "\"\n";
+    << "\nreason: \"" << quoted << "\"\n" << safetyResultLines();
   if (!f) ROS_ERROR("monitor: cannot write the result file %s", resultFile_.c_str());
 }
 
@@ -90,7 +93,7 @@ void MonitorNode::finish(uint8_t state, std::string reason) {
   if (ended()) return;
   const long last = completedStep();
   const double h = scenario_.timeStep;
-  const FormationOutcome formation = formationOutcome(convergedStep_, finalError_, h);
+  const FormationOutcome formation = outcome();
   const RunVerdict verdict = finishedRunVerdict(scenario_, formation);
   if (state == RunProgress::FINISHED) {
     const double seconds = (ros::WallTime::now() - firstStepAt_).toSec();
