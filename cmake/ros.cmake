@@ -97,7 +97,7 @@ if(CATKIN_ENABLE_TESTING)
     "case:=mujoco_unicycle world:=mujoco kinematics:=unicycle heading_seed:=7"
     "case:=mujoco_holonomic world:=mujoco"
     # Unicycles from scattered starts with the safety filter (doc/robots.md, "Safety"): no contact.
-    "case:=scatter6_unicycle_safety scenario:=${PROJECT_SOURCE_DIR}/test/ros/scatter6_safety.yaml kinematics:=unicycle heading_seed:=3")
+    "case:=scatter6_unicycle_safety scenario:=${PROJECT_SOURCE_DIR}/test/ros/scatter6_safety.yaml kinematics:=unicycle heading_seed:=3 time_limit:=90")
   # The monitor's safety report on a formation the filter blocks (closest approach, blocked).
   add_rostest(test/ros/safety_monitor.test)
   # render_bag.py on a recorded hexagon: video length, frames, processes left, bad inputs; and on

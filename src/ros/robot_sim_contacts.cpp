@@ -13,23 +13,27 @@ void RobotSimNode::setUpContacts(ros::NodeHandle& nh, ros::NodeHandle& pnh, int 
   const int robots = optionalParam(pnh, "robots", 0);
   const double bodyRadius = optionalParam(pnh, "body_radius", kBurgerBodyRadius);
   resultFile_ = optionalParam<std::string>(pnh, "result_file", "");
+  const bool count = optionalParam(pnh, "count_contacts", !resultFile_.empty());
   if (robots < 0) throw InvalidInput("~robots: must be >= 0, got " + std::to_string(robots));
   if (robots == 0) {
-    if (!resultFile_.empty()) throw InvalidInput("~result_file: contacts are counted only with ~robots > 0");
+    if (count) throw InvalidInput("~count_contacts, ~result_file: contacts are counted only with ~robots > 0");
     return;
   }
   if (id >= robots) {
     throw InvalidInput("~id: must be below ~robots (" + std::to_string(robots) + "), got " + std::to_string(id));
   }
+  if (!resultFile_.empty() && !count) throw InvalidInput("~result_file: needs ~count_contacts true");
   try {
     contacts_ = std::make_unique<BodyContacts>(robots, bodyRadius);
   } catch (const InvalidInput& e) {
     throw InvalidInput(std::string("~") + e.what());
   }
+  // Every robot tells where its body is; one robot (or a few) reads them all and counts.
+  truthPub_ = nh.advertise<nav_msgs::Odometry>("ground_truth", 10);
+  if (!count) return;
   // The other robots are robot_<j> beside this one: formation/robot_0 -> formation/robot_<j>.
   const std::string parent = ros::names::parentNamespace(nh.getNamespace());
   const std::string beside = parent == "/" ? "/" : parent + "/";
-  truthPub_ = nh.advertise<nav_msgs::Odometry>("ground_truth", 10);
   for (int j = 0; j < robots; ++j) {
     if (j == id) continue;
     others_.push_back(nh.subscribe<nav_msgs::Odometry>(
@@ -45,14 +49,14 @@ void RobotSimNode::setUpContacts(ros::NodeHandle& nh, ros::NodeHandle& pnh, int 
     resultFile_ = outputPath(ros::NodeHandle(parent), resultFile_);  // {ns}: the formation's, as the monitor's
     progressSub_ = nh.subscribe(beside + "progress", 10, &RobotSimNode::onProgress, this);
   }
+  counting_ = true;
   diagnostics_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh);
   diagnostics_->setHardwareID(childFrame_);
   diagnostics_->add("robot_sim", this, &RobotSimNode::diagnose);
 }
 
 void RobotSimNode::checkContacts(const ros::Time& stamp) {
-  // The robot that writes the result counts every pair; the others the pairs they are part of.
-  for (const ContactEvent& c : contacts_->check(stamp.toSec(), resultFile_.empty() ? id_ : -1)) {
+  for (const ContactEvent& c : contacts_->check(stamp.toSec())) {
     contactPub_.publish(worldContactMessage(c, stamp, worldFrame_, contacts_->log().count()));
     ROS_WARN("%s: contact %ld at t = %.3f s: %s and %s (bodies closer than %g m)", ros::this_node::getName().c_str(),
              contacts_->log().count(), c.time, c.first.c_str(), c.second.c_str(), 2.0 * contacts_->bodyRadius());
@@ -60,7 +64,10 @@ void RobotSimNode::checkContacts(const ros::Time& stamp) {
   if (runOver_ && !resultWritten_) {
     // The monitor writes the file before it says the run is over; this robot adds its lines.
     resultWritten_ = appendToResult(resultFile_, contacts_->log().resultLines());
-    if (resultWritten_) ROS_INFO("%s: %s", ros::this_node::getName().c_str(), contacts_->log().resultLines().c_str());
+    if (resultWritten_) {
+      ROS_INFO("%s: %ld contacts; closest body centres %.4f m (diameter %g m)", ros::this_node::getName().c_str(),
+               contacts_->log().count(), contacts_->closest(), 2.0 * contacts_->bodyRadius());
+    }
   }
   diagnostics_->update();
 }
@@ -70,7 +77,6 @@ void RobotSimNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
   status.summary(c.count() > 0 ? diagnostic_msgs::DiagnosticStatus::WARN : diagnostic_msgs::DiagnosticStatus::OK,
                  c.count() > 0 ? std::to_string(c.count()) + " contacts" : "no contacts");
   status.add("contacts", c.count());
-  status.add("counted pairs", resultFile_.empty() ? "this robot's" : "every robot's");
   status.add("touching now", c.active());
   status.add("first contact", c.first() ? "t = " + std::to_string(c.first()->time) + " s, " + c.first()->first +
                                               " and " + c.first()->second

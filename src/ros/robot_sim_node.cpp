@@ -135,7 +135,7 @@ void RobotSimNode::onTimer(const ros::TimerEvent&) {
   }
   lastTick_ = now;
   publish(now);
-  if (contacts_) checkContacts(now);
+  if (counting_) checkContacts(now);
 }
 
 void RobotSimNode::publish(const ros::Time& stamp) {

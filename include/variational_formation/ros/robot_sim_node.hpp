@@ -29,11 +29,12 @@ namespace vf {
  * stops when its commands stop for ~cmd_timeout).
  *
  * Body contacts (~robots > 0, doc/robots.md "Contacts"): it publishes its true pose on
- * `ground_truth` and reads the other robots' (robot_<j>/ground_truth beside its own namespace);
- * two bodies closer than 2 ~body_radius touch (BodyContacts, counted as the MuJoCo world counts
- * them). It reports the contacts it takes part in on ~contacts (WorldContact) and in its
- * diagnostics; the robot given ~result_file counts every pair and, once the monitor's `progress`
- * says the run is over, adds `contacts:` and `first_contact:` to that file, as mujoco_world does.
+ * `ground_truth`. With ~count_contacts (the default when ~result_file is given) it also reads the
+ * other robots' (robot_<j>/ground_truth beside its own namespace) and counts every pair whose
+ * bodies are closer than 2 ~body_radius (BodyContacts, counted as the MuJoCo world counts them),
+ * on ~contacts (WorldContact) and in its diagnostics; with ~result_file, once the monitor's
+ * `progress` says the run is over, it adds `contacts:` and `first_contact:` to that file, as
+ * mujoco_world does.
  */
 class RobotSimNode {
  public:
@@ -66,6 +67,7 @@ class RobotSimNode {
   long malformed_ = 0;
   int id_ = 0;
   std::unique_ptr<BodyContacts> contacts_;  // ~robots > 0
+  bool counting_ = false;                   // ~count_contacts: it reads every robot's pose
   ros::Publisher truthPub_, contactPub_;
   std::vector<ros::Subscriber> others_;
   ros::Subscriber progressSub_;
