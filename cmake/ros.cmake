@@ -123,7 +123,7 @@ endif()
 
 # robot_sim: one simulated holonomic robot (core PointRobot) per agent, with the interfaces of a
 # real one (cmd_vel in; nav_msgs/Odometry and tf out).
-add_executable(robot_sim src/ros/robot_sim_main.cpp src/ros/robot_sim_node.cpp src/ros/robot_sim_contacts.cpp)
+add_executable(robot_sim src/ros/robot_sim_contacts.cpp src/ros/robot_sim_main.cpp src/ros/robot_sim_node.cpp)
 target_include_directories(robot_sim SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(robot_sim variational_formation_ros variational_formation_contacts ${catkin_LIBRARIES})
 target_compile_options(robot_sim PRIVATE ${VF_FLAGS})

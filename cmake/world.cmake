@@ -14,7 +14,7 @@ if(NOT mujoco_FOUND OR NOT VF_MUJOCO_INCLUDE_DIR OR NOT VF_MUJOCO_LIBRARY)
 endif()
 
 # Contacts as both worlds count them (ContactLog; BodyContacts for robot_sim), without MuJoCo.
-add_library(variational_formation_contacts src/world/contact_log.cpp src/world/body_contacts.cpp)
+add_library(variational_formation_contacts src/world/body_contacts.cpp src/world/contact_log.cpp)
 target_link_libraries(variational_formation_contacts PUBLIC variational_formation_core)
 target_compile_options(variational_formation_contacts PRIVATE ${VF_FLAGS})
 set_target_properties(variational_formation_contacts PROPERTIES POSITION_INDEPENDENT_CODE ON)

@@ -1,6 +1,7 @@
 // robot_sim's body contacts (RobotSimNode, robot_sim_node.hpp; doc/robots.md "Contacts"): the
 // robots' true poses, BodyContacts, ~contacts, the diagnostics and the result file's lines.
 #include "variational_formation/core/error.hpp"
+#include "variational_formation/core/number_checks.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/participants.hpp"
 #include "variational_formation/ros/output_files.hpp"
@@ -56,7 +57,10 @@ void RobotSimNode::setUpContacts(ros::NodeHandle& nh, ros::NodeHandle& pnh, int 
 }
 
 void RobotSimNode::checkContacts(const ros::Time& stamp) {
-  for (const ContactEvent& c : contacts_->check(stamp.toSec())) {
+  // Times from the run's start (the monitor's RUNNING progress), else from this robot's first
+  // tick: as the MuJoCo world's, from 0.
+  if (origin_.isZero()) origin_ = stamp;
+  for (const ContactEvent& c : contacts_->check((stamp - origin_).toSec())) {
     contactPub_.publish(worldContactMessage(c, stamp, worldFrame_, contacts_->log().count()));
     ROS_WARN("%s: contact %ld at t = %.3f s: %s and %s (bodies closer than %g m)", ros::this_node::getName().c_str(),
              contacts_->log().count(), c.time, c.first.c_str(), c.second.c_str(), 2.0 * contacts_->bodyRadius());
@@ -78,7 +82,7 @@ void RobotSimNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
                  c.count() > 0 ? std::to_string(c.count()) + " contacts" : "no contacts");
   status.add("contacts", c.count());
   status.add("touching now", c.active());
-  status.add("first contact", c.first() ? "t = " + std::to_string(c.first()->time) + " s, " + c.first()->first +
+  status.add("first contact", c.first() ? "t = " + formatNumber(c.first()->time) + " s, " + c.first()->first +
                                               " and " + c.first()->second
                                         : std::string("none"));
   status.add("closest body distance [m]", contacts_->closest());
@@ -87,6 +91,10 @@ void RobotSimNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
 }
 
 void RobotSimNode::onProgress(const variational_formation::RunProgress::ConstPtr& msg) {
+  if (msg->state == variational_formation::RunProgress::RUNNING && !runStarted_) {
+    runStarted_ = true;
+    origin_ = ros::Time::now();
+  }
   runOver_ = msg->state == variational_formation::RunProgress::FINISHED ||
              msg->state == variational_formation::RunProgress::FAILED;
 }

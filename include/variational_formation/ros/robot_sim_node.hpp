@@ -72,6 +72,8 @@ class RobotSimNode {
   std::vector<ros::Subscriber> others_;
   ros::Subscriber progressSub_;
   std::string resultFile_;
+  ros::Time origin_;        // contact times count from here: the run's start, else the first tick
+  bool runStarted_ = false;
   bool runOver_ = false;  // the monitor's progress says so: add the lines to the result file
   bool resultWritten_ = false;
   std::unique_ptr<diagnostic_updater::Updater> diagnostics_;
