@@ -10,7 +10,7 @@ target_sources(variational_formation_ros PRIVATE src/ros/timed_agent_node.cpp sr
 # The monitor's two modes over its shared wiring, and the bounded pool of service calls.
 target_sources(variational_formation_ros PRIVATE src/ros/lockstep_monitor.cpp src/ros/monitor_commands.cpp
   src/ros/monitor_parameters.cpp src/ros/timed_monitor.cpp src/ros/monitor_outputs.cpp
-  src/ros/monitor_shape.cpp src/ros/monitor_goals.cpp src/ros/goal_server.cpp
+  src/ros/monitor_shape.cpp src/ros/monitor_goals.cpp src/ros/goal_server.cpp src/ros/monitor_safety.cpp
   src/ros/recorder_bag.cpp src/ros/recorder_commands.cpp
   src/ros/service_call.cpp src/ros/state_batch.cpp src/ros/periodic_call.cpp)
 add_dependencies(variational_formation_ros ${PROJECT_NAME}_gencfg)
@@ -97,7 +97,11 @@ if(CATKIN_ENABLE_TESTING)
     "case:=ring7_unicycle_lag01 scenario:=ring7 lag:=0.1 kinematics:=unicycle heading_seed:=3 time_limit:=90 expect_lag_warning:=true"
     "case:=ring7_unicycle_lag03 scenario:=ring7 lag:=0.3 kinematics:=unicycle heading_seed:=5 time_limit:=90 expect_lag_warning:=true"
     "case:=mujoco_unicycle world:=mujoco kinematics:=unicycle heading_seed:=7"
-    "case:=mujoco_holonomic world:=mujoco")
+    "case:=mujoco_holonomic world:=mujoco"
+    # Unicycles from scattered starts with the safety filter (doc/robots.md, "Safety"): no contact.
+    "case:=scatter6_unicycle_safety scenario:=${PROJECT_SOURCE_DIR}/test/ros/scatter6_safety.yaml kinematics:=unicycle heading_seed:=3 time_limit:=90")
+  # The monitor's safety report on a formation the filter blocks (closest approach, blocked).
+  add_rostest(test/ros/safety_monitor.test)
   # render_bag.py on a recorded hexagon: video length, frames, processes left, bad inputs; and on
   # robots.launch's wall-time bag: the video is the run from its first step, one name per robot.
   add_rostest(test/ros/render.test ARGS kind:=formation)
@@ -121,11 +125,11 @@ endif()
 
 # robot_sim: one simulated holonomic robot (core PointRobot) per agent, with the interfaces of a
 # real one (cmd_vel in; nav_msgs/Odometry and tf out).
-add_executable(robot_sim src/ros/robot_sim_main.cpp src/ros/robot_sim_node.cpp)
+add_executable(robot_sim src/ros/robot_sim_contacts.cpp src/ros/robot_sim_main.cpp src/ros/robot_sim_node.cpp)
 target_include_directories(robot_sim SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
-target_link_libraries(robot_sim variational_formation_ros variational_formation_core ${catkin_LIBRARIES})
+target_link_libraries(robot_sim variational_formation_ros variational_formation_contacts ${catkin_LIBRARIES})
 target_compile_options(robot_sim PRIVATE ${VF_FLAGS})
-add_dependencies(robot_sim ${catkin_EXPORTED_TARGETS})
+add_dependencies(robot_sim ${PROJECT_NAME}_generate_messages_cpp ${catkin_EXPORTED_TARGETS})
 install(TARGETS robot_sim RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 # The transport's ceiling for a nodelet run (benchmark/transport_ceiling.sh), built for the

@@ -3,7 +3,7 @@ if(CATKIN_ENABLE_TESTING)
   set(VF_CORE_TESTS formation force_model integrators metrics stability scenario free_particle lockstep simulation
     timed_agent link_faults point_robot unicycle_robot record_ledger layers manoeuvre lockstep_manoeuvre monitor
     rigidity slot_assignment shape_outcome safety_filter spatial_grid safety_scenario blocked_detector
-    sparse_spectrum goal_steering)
+    sparse_spectrum goal_steering timed_safety safety_watch)
   foreach(name ${VF_CORE_TESTS} command_desk)
     vf_add_gtest(test_${name} test/core/test_${name}.cpp variational_formation_core)
   endforeach()
@@ -12,6 +12,8 @@ if(CATKIN_ENABLE_TESTING)
   # The protocol's event sequences and seeded interleavings, over shipped and generated formations
   # (test_command_desk above, and test_protocol, which generates formations with the tools).
   vf_add_gtest(test_protocol test/core/test_protocol.cpp variational_formation_tools)
+  # robot_sim's body contacts, counted as the MuJoCo world counts them (no MuJoCo needed).
+  vf_add_gtest(test_body_contacts test/world/test_body_contacts.cpp variational_formation_contacts)
   foreach(name simulate_cli simulate_safety simulate_manoeuvre)
     vf_add_gtest(test_${name} test/tools/test_${name}.cpp variational_formation_tools)
   endforeach()

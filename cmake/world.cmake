@@ -13,11 +13,20 @@ if(NOT mujoco_FOUND OR NOT VF_MUJOCO_INCLUDE_DIR OR NOT VF_MUJOCO_LIBRARY)
     "scripts/test.sh installs it from package.xml's key libmujoco-dev).")
 endif()
 
-add_library(variational_formation_world src/world/contact_log.cpp src/world/mjcf_model.cpp
+# Contacts as both worlds count them (ContactLog; BodyContacts for robot_sim), without MuJoCo.
+add_library(variational_formation_contacts src/world/body_contacts.cpp src/world/contact_log.cpp)
+target_link_libraries(variational_formation_contacts PUBLIC variational_formation_core)
+target_compile_options(variational_formation_contacts PRIVATE ${VF_FLAGS})
+set_target_properties(variational_formation_contacts PROPERTIES POSITION_INDEPENDENT_CODE ON)
+install(TARGETS variational_formation_contacts
+  ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
+
+add_library(variational_formation_world src/world/mjcf_model.cpp
   src/world/mujoco_world.cpp src/world/step_response.cpp src/world/wheel_odometry.cpp src/world/world_settings.cpp)
 # Private: the world's headers declare MuJoCo's types without including mujoco.h.
 target_include_directories(variational_formation_world SYSTEM PRIVATE ${VF_MUJOCO_INCLUDE_DIR})
-target_link_libraries(variational_formation_world PUBLIC variational_formation_core PRIVATE ${VF_MUJOCO_LIBRARY})
+target_link_libraries(variational_formation_world PUBLIC variational_formation_contacts PRIVATE ${VF_MUJOCO_LIBRARY})
 target_compile_options(variational_formation_world PRIVATE ${VF_FLAGS})
 set_target_properties(variational_formation_world PROPERTIES POSITION_INDEPENDENT_CODE ON)
 install(TARGETS variational_formation_world

@@ -13,11 +13,14 @@ usage: make_agents_launch.py --scenario FILE --out FILE [--rate R] [--order forw
                               [--seed N] [--respawn-delay S] [--robot true|false [--lag S] [--noise M]
                                [--kinematics holonomic|unicycle] [--feedback integrated|odometry]
                                [--hand-offset M] [--heading-seed N] [--heading-noise RAD]
-                               [--world kinematic|mujoco [--physics-step S] [--friction F]]]]
+                               [--world kinematic|mujoco [--physics-step S] [--friction F]]
+                               [--body-radius M] [--result-file PATH]]]
                              [--ids LIST] [--manager-name NAME] [--agent-manager NAMES] [--in-launch]
 With --robot true (timed mode), each agent also gets a simulated robot, robot_sim, in
 formation/robot_<id> (odom and cmd_vel there), started at the scenario's initial position (a
 unicycle's hand point there, at the scenario's initial_heading or one drawn from --heading-seed).
+Every robot_sim counts body contacts (bodies closer than 2 --body-radius, default the TurtleBot3
+Burger's 0.105 m); robot 0 counts every pair and adds `contacts:` to --result-file at the end.
 With --world mujoco the robots are not robot_sim nodes but bodies of one MuJoCo world, which
 robots.launch starts (mujoco_world); the agents' robot lag is then the world's measured step
 response (world_step_response, with the world's --physics-step and --friction), not --lag.
@@ -189,7 +192,8 @@ def timed_args(args, i, lag):
 def robot_sim(args, i):
     """A simulated robot for agent i, at the scenario's initial position (the loader checked it)."""
     with open(args.scenario) as f:
-        agent = next(a for a in yaml.safe_load(f)["agents"] if int(a["id"]) == i)
+        agents = yaml.safe_load(f)["agents"]
+    agent = next(a for a in agents if int(a["id"]) == i)
     start = ", ".join(repr(float(x)) for x in agent["initial_position"])
     unicycle = []
     if args.kinematics == "unicycle":
@@ -206,7 +210,12 @@ def robot_sim(args, i):
             f'    <rosparam param="initial_position">[{start}]</rosparam>',
             f'    <param name="lag" type="double" value="{args.lag}"/>',
             f'    <param name="odometry_noise" type="double" value="{args.noise}"/>',
-            f'    <param name="seed" type="int" value="{args.seed + i}"/>'] + unicycle + ["  </node>"]
+            f'    <param name="seed" type="int" value="{args.seed + i}"/>',
+            # Body contacts (doc/robots.md "Contacts"): robot 0 counts every pair into the result file.
+            f'    <param name="robots" type="int" value="{len(agents)}"/>',
+            f'    <param name="body_radius" type="double" value="{args.body_radius}"/>'] + (
+        [f'    <param name="result_file" type="str" value={quoteattr(args.result_file)}/>']
+        if i == 0 and args.result_file else []) + unicycle + ["  </node>"]
 
 
 def main():
@@ -234,6 +243,8 @@ def main():
     parser.add_argument("--heading-seed", type=seed, default=0)
     parser.add_argument("--heading-noise", type=non_negative("heading_noise"), default="0.01")
     parser.add_argument("--world", choices=("kinematic", "mujoco"), default="kinematic")
+    parser.add_argument("--body-radius", type=positive("body_radius"), default="0.105")
+    parser.add_argument("--result-file", default="")
     parser.add_argument("--physics-step", type=positive("physics_step"), default="0.002")
     parser.add_argument("--friction", type=positive("friction"), default="1")
     parser.add_argument("--nodelet", type=boolean("nodelet"), default="false")

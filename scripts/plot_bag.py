@@ -91,8 +91,12 @@ def main():
     a = np.array([[status[k].angular_momentum.x, status[k].angular_momentum.y, status[k].angular_momentum.z]
                   for k in steps])
     prefix = args.prefix or scenario.name or "run"
-    for path in plots.plot_all(args.out_dir, prefix, prefix + " (distributed)", t, q, dimension,
-                                  energy, error, p, a, kappa, h, scenario.edges).values():
+    paths = plots.plot_all(args.out_dir, prefix, prefix + " (distributed)", t, q, dimension,
+                           energy, error, p, a, kappa, h, scenario.edges)
+    separation = np.array([status[k].min_separation for k in steps])  # NaN without a safety block
+    plots.add_separation(paths, args.out_dir, prefix, prefix + " (distributed)", t, separation,
+                         scenario.safety_radius)
+    for path in paths.values():
         print(f"wrote {path}")
     last = status[steps[-1]]
     print(f"converged: {'yes, from step %d' % last.converged_step if last.converged else 'no'}")

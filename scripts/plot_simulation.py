@@ -7,6 +7,7 @@ usage: plot_simulation.py --scenario FILE|NAME --traj traj.csv --metrics metrics
                           [--out-dir output] [--prefix NAME] [--commands FILE.csv]
 With a manoeuvre (the scenario's, or --commands as given to simulate) it also draws
 <prefix>_manoeuvre.png: the centroid's path against the commanded one, and the shape at a few instants.
+With a safety block it also draws <prefix>_separation.png: the closest pair over time against r.
 """
 import argparse
 import os
@@ -37,6 +38,7 @@ def main():
     prefix = args.prefix or scenario.name or "run"
     paths = plots.plot_all(args.out_dir, prefix, prefix, m.t, q, scenario.dimension, m.energy, m.error,
                            m.p, m.a, scenario.kappa, h, scenario.edges)
+    plots.add_separation(paths, args.out_dir, prefix, prefix, m.t, m.min_separation, scenario.safety_radius)
     commanded = data.commanded_velocities(args.scenario, len(m.t) - 1, h, args.commands)
     if commanded is not None:
         paths["manoeuvre"] = os.path.join(args.out_dir, f"{prefix}_manoeuvre.png")

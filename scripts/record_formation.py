@@ -63,7 +63,8 @@ def main():
     pattern = "^" + re.escape(ns.rstrip("/")) + "/.*" if ns != "/" else ".*"
     # With -e every topic argument is a regular expression.
     topics = [pattern, "^/tf$", "^/tf_static$"] + ["^" + re.escape(t) + "$" for t in args.topics]
-    command = [record[0], "-O", path, "-e"] + topics + ros_args
+    # robot_sim's ground_truth is the true pose that /tf already holds: left out.
+    command = [record[0], "-O", path, "-e"] + topics + ["-x", ".*/ground_truth$"] + ros_args
     os.execv(record[0], command)
 
 

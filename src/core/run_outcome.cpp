@@ -47,6 +47,7 @@ RunVerdict finishedRunVerdict(const Scenario& scenario, const FormationOutcome& 
 
 RunVerdict finishedRunVerdict(const Scenario& scenario, const ShapeOutcome& shape) {
   if (shape.verdict == ShapeVerdict::NotConverged) {
+    if (!shape.blocked.empty()) return finishedRunVerdict(scenario, blockedOutcome(shape.blocked, shape.findings.maxEdgeError));
     return finishedRunVerdict(scenario, formationOutcome(-1, shape.findings.maxEdgeError, scenario.timeStep));
   }
   RunVerdict v;

@@ -274,10 +274,13 @@ void safetyConstraints(const SafetySettings& s, int d, const double* q, const st
     HalfSpace c;
     for (int a = 0; a < d; ++a) c.normal[a] = q[a] - sensed[j].position[a];
     const double zz = dot(d, c.normal, c.normal);
-    if (!(zz < reach2)) continue;
+    // An old position widens r and R by its margin (doc/robots.md "Safety"); 0 keeps them as they are.
+    const double margin = sensed[j].margin;
+    const double reach = s.sensingRadius + margin, radius = s.radius + margin;
+    if (!(zz < (margin == 0.0 ? reach2 : reach * reach))) continue;
     // doc/maths.md §10, pairs: 2 z·δ >= -(γ/2)(|z|^2 - r^2); agent j states the same with -z.
     for (int a = 0; a < d; ++a) c.normal[a] *= 2.0;
-    c.bound = std::min(0.0, -0.5 * s.gamma * (zz - r2));
+    c.bound = std::min(0.0, -0.5 * s.gamma * (zz - (margin == 0.0 ? r2 : radius * radius)));
     c.source = sensed[j].id;
     out.push_back(c);
   }

@@ -21,6 +21,14 @@ ShapeFindings findShape(const Formation& formation, const Positions& q, const Ve
   return f;
 }
 
+ShapeOutcome blockedShapeOutcome(ShapeOutcome outcome, const std::string& blocked) {
+  outcome.verdict = ShapeVerdict::NotConverged;
+  outcome.convergedStep = -1;
+  outcome.blocked = blocked;
+  outcome.line = "not converged (" + blocked + ")";
+  return outcome;
+}
+
 bool shapeErrorMeasuredAt(long step, int agents, long lastStep) {
   const long every = static_cast<long>(std::ceil(std::pow(agents / 200.0, 2)));
   return every <= 1 || step % every == 0 || (lastStep > 0 && step == lastStep);

@@ -1,5 +1,6 @@
 #include "variational_formation/core/timed_agent.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -10,6 +11,13 @@
 namespace vf {
 
 namespace {
+
+bool allFinite(const std::vector<double>& q) {
+  for (double x : q) {
+    if (!std::isfinite(x)) return false;
+  }
+  return true;
+}
 
 void checkPosition(const char* field, const std::vector<double>& q, int dimension) {
   if (static_cast<int>(q.size()) != dimension) {
@@ -59,9 +67,28 @@ std::string TimedAgent::describe(Receipt receipt) {
   return "?";
 }
 
+void TimedAgent::enableSafety(const Scenario& scenario, double maxSpeed, double handOffset) {
+  if (!scenario.safety) throw InvalidInput("safety: the scenario has no safety block");
+  safety_.emplace(scenario, id(), maxSpeed, handOffset);
+}
+
 TimedAgent::Receipt TimedAgent::receive(long sender, long step, const std::vector<double>& position,
-                                        const std::vector<double>& previousPosition, double now) {
-  const Receipt receipt = accept(sender, step, position, previousPosition, now);
+                                        const std::vector<double>& previousPosition, double now, double sentAt) {
+  Receipt receipt = accept(sender, step, position, previousPosition, now);
+  if (safety_ && (receipt == Receipt::Accepted || receipt == Receipt::UnknownSender) && sender >= 0 &&
+      sender < static_cast<long>(neighbours_.size()) && sender != id()) {
+    // Any agent of the formation may come within the sensing radius: the filter keeps them all.
+    if (static_cast<int>(position.size()) != dimension_) {
+      receipt = Receipt::WrongDimension;
+    } else if (!allFinite(position) || !allFinite(previousPosition)) {
+      receipt = Receipt::NonFinite;
+    } else if (step < 0) {
+      receipt = Receipt::NegativeStep;
+    } else {
+      safety_->hold(static_cast<int>(sender), position.data(), std::isnan(sentAt) ? now : sentAt);
+      if (receipt == Receipt::UnknownSender) receipt = Receipt::Accepted;  // not a neighbour: the filter's only
+    }
+  }
   if (receipt == Receipt::Accepted) {
     ++accepted_;
   } else {
@@ -119,6 +146,16 @@ TimedAgent::TickResult TimedAgent::tick(double now) {
     NeighbourStatus s = status(j, now);
     if (s.stale) result.stale.push_back(s);
   }
+  if (safety_) {
+    // The filter needs every agent's position once: where an agent is unknown, no step is safe.
+    for (int j : safety_->unheard()) {
+      if (std::find(neighbourIds().begin(), neighbourIds().end(), j) == neighbourIds().end()) {
+        result.stale.push_back(status(j, now));
+      }
+    }
+  }
+  tickNow_ = now;
+  constraintsActive_ = 0;
   if (!result.stale.empty()) {
     hold();
   } else {
@@ -195,6 +232,14 @@ void TimedAgent::move(const double* gradient, const ManoeuvreGains* g, const dou
     // doc/maths.md §2, explicit update, as in VariationalIntegrator::step.
     variationalUpdate(coefficients_, dimension_, qPrev_.data(), q_.data(), gradient, next.data());
     for (int a = 0; a < dimension_; ++a) v_[a] = (next[a] - q_[a]) / h;
+  }
+  if (safety_) {
+    // doc/robots.md "Safety": the same filter as every run, on the step just computed.
+    const SafeStep& filtered = safety_->filter(tickNow_, q_.data(), next.data());
+    constraintsActive_ = safety_->constraintsActive();
+    if (filtered.projection.changed) {
+      for (int a = 0; a < dimension_; ++a) v_[a] = (next[a] - q_[a]) / h;
+    }
   }
   qPrev_.swap(q_);
   q_.swap(next);

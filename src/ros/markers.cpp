@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "variational_formation/core/spatial_grid.hpp"
+
 namespace vf {
 
 namespace {
@@ -223,6 +225,47 @@ visualization_msgs::MarkerArray makeMarkers(const FormationSnapshot& s, const Fo
   out.markers.push_back(statusText(s, n, ghostAt, radius, stamp));
   if (schedule) out.markers.push_back(commandArrow(ghostAt, radius, stamp));
   return out;
+}
+
+void addSafetyMarkers(const FormationSnapshot& s, const SafetySettings& safety, const std::vector<Obstacle>& obstacles,
+                      visualization_msgs::MarkerArray& out) {
+  using visualization_msgs::Marker;
+  const ros::Time stamp = ros::Time::now();
+  const Positions& q = s.positions;
+  const bool flat = q.rows() == 2;
+  const double thickness = 0.02;  // [m] of a disc on the plane
+  SpatialGrid grid;
+  grid.build(q, safety.sensingRadius);
+  std::vector<int> near;
+  for (int i = 0; i < static_cast<int>(q.cols()); ++i) {
+    near.clear();
+    grid.within(q, i, safety.sensingRadius, near);
+    double closest = safety.sensingRadius;
+    for (int j : near) closest = std::min(closest, (q.col(i) - q.col(j)).norm());
+    // 0 at r or nearer, 1 at R or farther: red, through yellow, to green.
+    const double t = std::clamp((closest - safety.radius) / (safety.sensingRadius - safety.radius), 0.0, 1.0);
+    Marker disc = base("safety_discs", i, flat ? Marker::CYLINDER : Marker::SPHERE, stamp);
+    disc.pose.position = point(column3(q, i));
+    disc.scale.x = disc.scale.y = safety.radius;  // diameter r: radius r/2
+    disc.scale.z = flat ? thickness : safety.radius;
+    disc.color = rgba(std::min(1.0, 2.0 - 2.0 * t), std::min(1.0, 2.0 * t), 0.1, 0.45);
+    out.markers.push_back(disc);
+  }
+  for (std::size_t k = 0; k < obstacles.size(); ++k) {
+    const Obstacle& o = obstacles[k];
+    const bool ball = o.shape == Obstacle::Shape::Ball;
+    Marker m = base("obstacles", static_cast<int>(k), ball ? (flat ? Marker::CYLINDER : Marker::SPHERE) : Marker::CUBE,
+                    stamp);
+    const Eigen::Vector3d centre = ball ? o.centre : Eigen::Vector3d(0.5 * (o.min + o.max));
+    const Eigen::Vector3d size = ball ? Eigen::Vector3d::Constant(2.0 * o.radius) : Eigen::Vector3d(o.max - o.min);
+    m.pose.position = point(centre);
+    m.scale.x = std::max(size.x(), 1e-3);
+    m.scale.y = std::max(size.y(), 1e-3);
+    m.scale.z = flat ? 0.3 : std::max(size.z(), 1e-3);  // a low wall on the plane
+    if (flat) m.pose.position.z = 0.15;
+    m.color = rgba(0.45, 0.45, 0.45, 0.8);
+    out.markers.push_back(m);
+  }
 }
 
 }  // namespace vf

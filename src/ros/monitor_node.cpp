@@ -79,6 +79,7 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh, bool timed) 
   progress_.converged_step = -1;
   setUpCommands(nh, pnh);
   setUpGoals(nh, pnh);
+  setUpSafety(pnh, timed);
   setUpParameters(nh, timed);
 }
 
@@ -127,7 +128,9 @@ bool MonitorNode::admit(int agent, const AgentState& msg, const std::string& pub
     finish(RunProgress::FAILED, agents_[static_cast<std::size_t>(agent)].node + ": " + msg.failure);
     return false;
   }
-  return offer(agent, msg, publisher);
+  if (!offer(agent, msg, publisher)) return false;
+  noteSafety(agent, msg);
+  return true;
 }
 
 void MonitorNode::heard(int agent, const std::string& publisher) {

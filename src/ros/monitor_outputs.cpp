@@ -32,8 +32,8 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
   status.commands = static_cast<uint32_t>(commandsIssued());
   status.shape_error = s.shape.shapeError;  // NaN at steps it skips (FormationSnapshot::shape)
   noteShape(s);
-  // Not measured yet: NaN says so (FormationStatus.msg).
-  status.min_separation = std::numeric_limits<double>::quiet_NaN();
+  status.min_separation = std::numeric_limits<double>::quiet_NaN();  // without a safety block (FormationStatus.msg)
+  const bool blocked = watchSafety(s, status);
   if (!noetherHolds) {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     status.linear_momentum_predicted.x = status.linear_momentum_predicted.y = status.linear_momentum_predicted.z = nan;
@@ -55,6 +55,7 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
   const bool edge = s.metrics.step == 0 || (last > 0 && s.metrics.step == last);
   if (edge || (s.metrics.step % markerEvery_ == 0 && (recording_ || markersPub_.getNumSubscribers() > 0))) {
     out.second = makeMarkers(s, measure().formation(), trails_, commandSchedule(), scenario_.timeStep);
+    if (scenario_.safety) addSafetyMarkers(s, *scenario_.safety, scenario_.obstacles, out.second);
     for (auto& m : out.second.markers) {
       m.header.stamp = stamp;
       m.header.frame_id = worldFrame_;
@@ -71,6 +72,7 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
     ROS_INFO("monitor: left the desired shape at step %ld", s.metrics.step);
     reportedConvergence_ = -2;
   }
+  if (blocked) finish(RunProgress::FINISHED, "");  // the formation cannot form: say so instead of running on
   return out;
 }
 
@@ -85,7 +87,7 @@ void MonitorNode::writeResult(const std::string& result, const std::string& reas
     << "\nshape_error: " << formation.findings.shapeError << "\nformation: \""
     << formation.line << "\"\nfinal_max_distance_error: " << finalError_ << "\ndropped: " << dropped_ << "\ncommands: " << commandsIssued()
     << "\ncommands_refused: " << commandsRefused_ << "\ncommands_saturated: " << desk_->saturated()
-    << "\nreason: \"" << quoted << "\"\n";
+    << "\nreason: \"" << quoted << "\"\n" << safetyResultLines();
   if (!f) ROS_ERROR("monitor: cannot write the result file %s", resultFile_.c_str());
 }
 

@@ -19,7 +19,9 @@ ShapeOutcome MonitorNode::shapeVerdict() const {
   if (std::isnan(f.shapeError) && lastPositions_.size() > 0) {
     f.shapeError = measure().formation().shapeError(lastPositions_, lastScale_);
   }
-  return shapeOutcome(f, convergedStep_, scenario_.mirrorAllowed, scenario_.timeStep);
+  const ShapeOutcome o = shapeOutcome(f, convergedStep_, scenario_.mirrorAllowed, scenario_.timeStep);
+  const std::string blocked = blockedBy();
+  return blocked.empty() ? o : blockedShapeOutcome(o, blocked);
 }
 
 }  // namespace vf

@@ -8,13 +8,13 @@
 #include <rosgraph_msgs/Clock.h>
 #include <sensor_msgs/JointState.h>
 
-#include "variational_formation/WorldContact.h"
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/number_checks.hpp"
 #include "variational_formation/core/scenario.hpp"
 #include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/world_contact.hpp"
 #include "variational_formation/world/mjcf_model.hpp"
 
 namespace vf {
@@ -136,15 +136,7 @@ void MujocoWorldNode::advance(double until) {
   while (world_->time() + halfStep < until) {
     world_->step();
     for (const ContactEvent& c : world_->newContacts()) {
-      variational_formation::WorldContact msg;
-      msg.header.stamp = stamp();
-      msg.header.frame_id = worldFrame_;
-      msg.first = c.first;
-      msg.second = c.second;
-      msg.sim_time = c.time;
-      msg.normal_force = c.normalForce;
-      msg.count = world_->contacts().count();
-      contactPub_.publish(msg);
+      contactPub_.publish(worldContactMessage(c, stamp(), worldFrame_, world_->contacts().count()));
       ROS_WARN("%s: contact %ld at t = %.3f s: %s and %s, normal force %.3g N", ros::this_node::getName().c_str(),
                world_->contacts().count(), c.time, c.first.c_str(), c.second.c_str(), c.normalForce);
     }

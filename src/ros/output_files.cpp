@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 
 namespace vf {
 
@@ -34,6 +35,17 @@ void announceReplacedResult(const std::string& path) {
   std::string first;
   if (!f || !std::getline(f, first) || first == "result: running") return;
   ROS_WARN("monitor: replacing the result of an earlier run in %s (%s)", path.c_str(), first.c_str());
+}
+
+bool appendToResult(const std::string& path, const std::string& lines) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string body = text.str();
+  if (body.find("result: ") == std::string::npos || body.find("result: running") != std::string::npos) return false;
+  std::ofstream out(path, std::ios::app);
+  out << lines;
+  return static_cast<bool>(out);
 }
 
 void replaceEarlierBag(const std::string& path) {

@@ -11,8 +11,25 @@
 
 namespace vf {
 
+namespace {
+/// The true pose on `ground_truth` (as a simulator's ground-truth odometry plugin publishes it).
+void publishTruth(ros::Publisher& pub, const std_msgs::Header& header, const std::string& child,
+                  const std::vector<double>& p, double heading) {
+  nav_msgs::Odometry truth;
+  truth.header = header;
+  truth.child_frame_id = child;
+  truth.pose.pose.position.x = p[0];
+  truth.pose.pose.position.y = p[1];
+  truth.pose.pose.position.z = p[2];
+  truth.pose.pose.orientation.z = std::sin(0.5 * heading);
+  truth.pose.pose.orientation.w = std::cos(0.5 * heading);
+  pub.publish(truth);
+}
+}  // namespace
+
 RobotSimNode::RobotSimNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   const int id = requiredParam<int>(pnh, "id");
+  id_ = id;
   if (id < 0) throw InvalidInput("~id: must be >= 0, got " + std::to_string(id));
   const std::vector<double> initial = requiredParam<std::vector<double>>(pnh, "initial_position");
   const double rate = optionalParam(pnh, "rate", 100.0);
@@ -72,6 +89,7 @@ RobotSimNode::RobotSimNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     throw InvalidInput(std::string("~") + e.what());  // the core names the parameter without '~'
   }
   childFrame_ = prefix + "base_link";
+  setUpContacts(nh, pnh, id);
   odomPub_ = nh.advertise<nav_msgs::Odometry>("odom", 100);
   commandSub_ = nh.subscribe("cmd_vel", 100, &RobotSimNode::onCommand, this, ros::TransportHints().tcpNoDelay());
   timer_ = nh.createTimer(ros::Duration(1.0 / rate), &RobotSimNode::onTimer, this);
@@ -117,6 +135,7 @@ void RobotSimNode::onTimer(const ros::TimerEvent&) {
   }
   lastTick_ = now;
   publish(now);
+  if (counting_) checkContacts(now);
 }
 
 void RobotSimNode::publish(const ros::Time& stamp) {
@@ -144,6 +163,10 @@ void RobotSimNode::publish(const ros::Time& stamp) {
     tf.transform.rotation.z = std::sin(0.5 * truth.heading);
     tf.transform.rotation.w = std::cos(0.5 * truth.heading);
     tf_.sendTransform(tf);
+    if (contacts_) {
+      contacts_->setPosition(id_, truth.x, truth.y);  // the body's centre: the axle
+      publishTruth(truthPub_, header, childFrame_, {truth.x, truth.y, 0.0}, truth.heading);
+    }
     return;
   }
   const std::vector<double>& p = point_->position();
@@ -163,6 +186,10 @@ void RobotSimNode::publish(const ros::Time& stamp) {
   odom.twist.twist.linear.z = planar ? 0.0 : v[2];
   odomPub_.publish(odom);
   tf_.sendTransform(frameAt(header, childFrame_, {p[0], p[1], planar ? 0.0 : p[2]}));
+  if (contacts_) {
+    contacts_->setPosition(id_, p[0], p[1], planar ? 0.0 : p[2]);
+    publishTruth(truthPub_, header, childFrame_, {p[0], p[1], planar ? 0.0 : p[2]}, 0.0);
+  }
 }
 
 }  // namespace vf

@@ -1,6 +1,8 @@
 #include "variational_formation/ros/timed_agent_node.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/Twist.h>
@@ -49,13 +51,22 @@ TimedAgentNode::TimedAgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   frame_ = ns + name_;
   statePub_ = nh.advertise<AgentState>(name_ + "/state", 100, /*latch=*/true);
   posePub_ = nh.advertise<geometry_msgs::PoseStamped>(name_ + "/pose", 10);
-  for (int j : agent_->neighbourIds()) neighbourOwners_.push_back(agentNodeName(nh, j));
-  subscribeToFormation(
-      nh, agent_->neighbourIds(), 100,
-      [this](int j, const ros::MessageEvent<AgentState const>& e) { onNeighbourState(j, e); },
-      [this](const ros::MessageEvent<RunProgress const>& e) { onProgress(e); }, subs_, progressSub_);
   worldFrame_ = worldFrame(pnh);
   if (robot_) setUpRobot(nh, pnh, scenario, id);
+  if (scenario.safety) setUpSafety(scenario);
+  // With safety on every agent may come near: the filter hears them all (doc/robots.md "Safety").
+  std::vector<int> heard = agent_->neighbourIds();
+  if (agent_->safety()) {
+    heard.clear();
+    for (int j = 0; j < scenario.agentCount(); ++j) {
+      if (j != id) heard.push_back(j);
+    }
+  }
+  for (int j : heard) owners_[j] = agentNodeName(nh, j);
+  subscribeToFormation(
+      nh, heard, 100,
+      [this](int j, const ros::MessageEvent<AgentState const>& e) { onNeighbourState(j, e); },
+      [this](const ros::MessageEvent<RunProgress const>& e) { onProgress(e); }, subs_, progressSub_);
   commandSub_ = nh.subscribe<variational_formation::FormationCommands>(
       "command", 10,
       boost::function<void(const ros::MessageEvent<variational_formation::FormationCommands const>&)>(
@@ -91,9 +102,7 @@ void TimedAgentNode::drop(const std::string& why) {
 }
 
 void TimedAgentNode::onNeighbourState(int neighbour, const ros::MessageEvent<AgentState const>& event) {
-  std::size_t k = 0;
-  while (agent_->neighbourIds()[k] != neighbour) ++k;
-  if (!fromOwner(event, neighbourOwners_[k])) {
+  if (!fromOwner(event, owners_.at(neighbour))) {
     drop("a state on agent_" + std::to_string(neighbour) + "'s topic from " + event.getPublisherName() +
          ", which does not own it");
     return;
@@ -101,6 +110,26 @@ void TimedAgentNode::onNeighbourState(int neighbour, const ros::MessageEvent<Age
   const AgentState& msg = *event.getConstMessage();
   // The id check is the core's (UnknownSender); the faults act on what the network delivered.
   faults_->offer({static_cast<int>(msg.id) == neighbour ? neighbour : -1, msg}, now());
+}
+
+void TimedAgentNode::setUpSafety(const Scenario& scenario) {
+  // Robot mode: the link saturates cmd_vel at ~max_speed, so that bounds the robots when the
+  // scenario gives no safety.max_speed (doc/robots.md "Safety"); timed mode needs the scenario's.
+  const double robotSpeed = robot_ ? link_->settings().hand.maxSpeed : std::numeric_limits<double>::quiet_NaN();
+  const bool unicycle = robot_ && link_->settings().kinematics == RobotKinematics::Unicycle;
+  const double handOffset = unicycle ? link_->settings().hand.handOffset : 0.0;
+  agent_->enableSafety(scenario, timedSafetySpeed(*scenario.safety, robotSpeed), handOffset);
+  const SafetySettings& s = agent_->safety()->settings();
+  ROS_INFO("%s: safety filter on: r %g m (%s), sensing radius %g m, gamma %g, max speed %g m/s (%s); every "
+           "agent's state is heard, and r widens by age x max speed",
+           name_.c_str(), s.radius, unicycle ? "with 2 x hand_offset" : "the scenario's", s.sensingRadius, s.gamma,
+           s.maxSpeed, std::isfinite(scenario.safety->maxSpeed) ? "the scenario's" : "the robot link's ~max_speed");
+}
+
+double TimedAgentNode::sentAt(const AgentState& state) const {
+  // The stamp is ROS time: on the wall clock unless a simulator sets it; then the receive time.
+  if (ros::Time::isSimTime() || state.header.stamp.isZero()) return std::numeric_limits<double>::quiet_NaN();
+  return std::min(state.header.stamp.toSec(), now());
 }
 
 void TimedAgentNode::onProgress(const ros::MessageEvent<RunProgress const>& event) {
@@ -149,7 +178,7 @@ void TimedAgentNode::onTick() {
   for (Received& r : faults_->takeDue(t)) {
     const AgentState& s = r.state;
     try {
-      const auto receipt = agent_->receive(r.sender, s.step, s.position, s.previous_position, t);
+      const auto receipt = agent_->receive(r.sender, s.step, s.position, s.previous_position, t, sentAt(s));
       if (receipt == TimedAgent::Receipt::Accepted) {
         newest_[r.sender] = s;
       } else if (receipt != TimedAgent::Receipt::Outdated) {

@@ -34,6 +34,11 @@ void TimedAgentNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
   status.add("states refused (outdated or malformed)", agent_->dropped());
   status.add("states dropped (not from the owner)", dropped_);
   status.add("kappa [1/s]", agent_->dampingGain());
+  if (agent_->safety()) {
+    status.add("safety: constraints active", agent_->constraintsActive());
+    status.add("safety: r [m]", agent_->safety()->settings().radius);
+    status.add("safety: max speed [m/s]", agent_->safety()->maxSpeed());
+  }
   if (robot_) {
     status.add("kinematics", kinematicsName(link_->settings().kinematics));
     status.add("feedback", feedbackName(link_->settings().feedback));
@@ -95,6 +100,7 @@ void TimedAgentNode::publish() {
   msg.position = agent_->position();
   msg.previous_position = agent_->previousPosition();
   msg.dropped = static_cast<uint32_t>(dropped_ + agent_->dropped());
+  msg.constraints_active = static_cast<uint32_t>(agent_->constraintsActive());
   statePub_.publish(msg);
   lastPublishAt_ = ros::WallTime::now();
 

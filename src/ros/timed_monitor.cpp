@@ -50,6 +50,7 @@ void TimedMonitor::tick() {
   for (const FormationSnapshot& s : done) {
     publishSnapshot(s, stampOf(s.metrics.step), referee_->dataAge(), false);
   }
+  if (ended()) return;  // a blocked formation ended the run (monitor_safety.cpp)
   if (desk_->pending()) commandOffered();  // a goal's command (GoalServer): timed mode issues at once
   // The progress starts the agents at the first tick (start by identity, as in lockstep); after
   // that they ignore the window, and it says every quarter window how far the run is.

@@ -141,7 +141,7 @@ def scenario_path(name_or_path):
 def read_scenario(name_or_path):
     """The fields of a scenario (a file, or a name: scenario_path) that the plots use, already
     checked by the package's loader: name, dimension, kappa, time_step, n, desired (n x d
-    array) and edges."""
+    array), edges, and safety_radius (the safety block's r, None without one)."""
     path = scenario_path(name_or_path)
     try:
         with open(path) as f:
@@ -151,6 +151,7 @@ def read_scenario(name_or_path):
             name=str(s.get("name", "")), dimension=int(s["dimension"]), kappa=float(s["kappa"]),
             time_step=float(s["time_step"]), n=len(agents),
             desired=np.array([a["desired_position"] for a in agents], float),
-            edges=[tuple(e) for e in s.get("edges") or []])
+            edges=[tuple(e) for e in s.get("edges") or []],
+            safety_radius=float(s["safety"]["radius"]) if s.get("safety") else None)
     except (OSError, yaml.YAMLError, KeyError, TypeError, ValueError, AttributeError) as e:
         fail(f"{path}: cannot read the scenario ({e})")

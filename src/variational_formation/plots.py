@@ -98,6 +98,34 @@ def plot_error(path, title, t, error):
     _plot_semilogy(path, title, t, error, "max |distance - desired| over edges [m]", "formation error")
 
 
+def plot_separation(path, title, t, separation, radius):
+    """The closest pair's distance at each step against the safety radius r (doc/maths.md §10):
+    the filter keeps the curve above the line."""
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    ax.plot(t, separation, label="closest pair")
+    ax.axhline(radius, color="red", linestyle="--", label=f"r = {radius:g} m")
+    finite = separation[np.isfinite(separation)]
+    if finite.size:
+        ax.set_ylim(0.0, max(2.0 * radius, 1.1 * float(np.max(finite))))
+    ax.set_xlabel("t [s]")
+    ax.set_ylabel("min separation [m]")
+    ax.set_title(f"{title}: separation")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def add_separation(paths, out_dir, prefix, title, t, separation, radius):
+    """<prefix>_separation.png into `paths` when the run had a safety filter (radius not None and
+    some separation measured)."""
+    if radius is None or not np.any(np.isfinite(separation)):
+        return
+    paths["separation"] = os.path.join(out_dir, f"{prefix}_separation.png")
+    plot_separation(paths["separation"], title, t, separation, radius)
+
+
 def momentum_residuals(p, a, kappa, h):
     """Largest |X_k - e^{-kappa t_k} X_0| for X = P and A, absolute."""
     steps = np.arange(p.shape[0], dtype=float)

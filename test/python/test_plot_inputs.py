@@ -137,6 +137,20 @@ class PlotInputs(unittest.TestCase):
         self.assertEqual(status, 0, err)
         self.assertIn(f"steps: {STEPS},", out)
 
+    def test_separation_is_plotted_against_r_with_a_safety_block(self):
+        # test/scenarios/blocked_line.yaml: its agents 1 and 2 are held r = 0.25 m apart.
+        scenario = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenarios", "blocked_line.yaml")
+        traj, metrics = os.path.join(self.tmp, "blocked_traj.csv"), os.path.join(self.tmp, "blocked_metrics.csv")
+        subprocess.run(["rosrun", PKG, "simulate", "--scenario", scenario, "--out", traj, "--metrics", metrics,
+                        "--steps", "200"], capture_output=True)  # exit status 0 or 1: it is blocked
+        status, out, err = script("plot_simulation.py", "--scenario", scenario, "--traj", traj, "--metrics", metrics,
+                                  "--out-dir", self.tmp, "--prefix", "blocked")
+        self.assertEqual(status, 0, err)
+        self.assertIn(f"wrote {os.path.join(self.tmp, 'blocked_separation.png')}", out)
+        self.assertGreater(os.path.getsize(os.path.join(self.tmp, "blocked_separation.png")), 1000)
+        # Without a safety block there is no separation to plot.
+        self.assertFalse(os.path.exists(os.path.join(self.tmp, "square_separation.png")))
+
     def test_roa_map_of_another_formation_is_refused(self):
         roa = os.path.join(self.tmp, "roa.csv")
         subprocess.run(["rosrun", PKG, "roa", "--scenario", "hexagon", "--agent", "1", "--x-range", "-1", "1",

@@ -19,8 +19,13 @@ agents' states.
   both numbers in its diagnostics; the case says whether the lag exceeds the margin (ring7's
   margin is 0.05 s, the hexagon's wider than 0.114 s). In the MuJoCo world the lag is the one
   world_step_response measures.
-- MuJoCo world: the result file gains `contacts: 0` and `first_contact: ~` (the hexagon's robots
-  never touch), and every robot publishes joint_states.
+- Both worlds add `contacts: 0` and `first_contact: ~` to the result file (robot_sim's robot 0,
+  or the MuJoCo world): no two robot bodies ever touch. The MuJoCo world's robots publish
+  joint_states.
+- A scenario with `safety:` (the scattered unicycles): the filter bound (filter_active_steps > 0
+  in the result file, constraints_active > 0 in some status), and the closest approach of the
+  agents' points is at least r + 2 hand_offset minus what stale data can cost (checked loosely:
+  >= r).
 """
 import math
 import os
@@ -89,8 +94,8 @@ class RobotsRun(unittest.TestCase):
             steering.close()
         result_file = os.path.join(cls.out, name + ".result.yaml")
         cls.result = vf_rostest.wait_for_result(result_file, steps * h + 30.0)
-        # The MuJoCo world adds its contacts once the monitor has written the file.
-        end = time.time() + (10 if cls.world == "mujoco" else 0)
+        # The world (robot_sim's robot 0, or mujoco_world) adds its contacts once the monitor has written the file.
+        end = time.time() + 10
         while "contacts" not in cls.result and time.time() < end:
             time.sleep(0.2)
             cls.result = vf_rostest.wait_for_result(result_file, 0)
@@ -286,15 +291,27 @@ class RobotsRun(unittest.TestCase):
             self.assertEqual(exceeds, self.expect_lag_warning, values)
 
     def test_world_reports_its_contacts(self):
-        if self.world != "mujoco":
-            self.assertNotIn("contacts", self.result)
-            return
-        print(f"MuJoCo world: contacts {self.result.get('contacts')}, first {self.result.get('first_contact')}",
+        print(f"{self.world} world: contacts {self.result.get('contacts')}, first {self.result.get('first_contact')}",
               flush=True)
         self.assertEqual(self.result.get("contacts"), 0, self.result)
         self.assertIn("first_contact", self.result)
         self.assertIsNone(self.result["first_contact"])
-        self.assertEqual(sorted(self.joint_states), sorted(f"/formation/robot_{i}/joint_states" for i in range(self.n())))
+        if self.world == "mujoco":
+            self.assertEqual(sorted(self.joint_states),
+                             sorted(f"/formation/robot_{i}/joint_states" for i in range(self.n())))
+
+    def test_safety_filter_bound(self):
+        safety = self.scenario.get("safety")
+        if not safety:
+            self.assertNotIn("filter_active_steps", self.result)
+            return
+        closest = self.result.get("closest_approach")
+        print(f"safety: filter active in {self.result.get('filter_active_steps')} steps, closest approach {closest}, "
+              f"statuses with constraints active: {sum(1 for _, s in self.status if s.constraints_active > 0)}",
+              flush=True)
+        self.assertGreater(int(self.result.get("filter_active_steps", 0)), 0, self.result)
+        self.assertTrue(any(s.constraints_active > 0 for _, s in self.status))
+        self.assertGreaterEqual(closest["distance"], safety["radius"], self.result)
 
 
 if __name__ == "__main__":

@@ -25,6 +25,10 @@ struct ShapeFindings {
 ShapeFindings findShape(const Formation& formation, const Positions& q, const Velocities& v, double scale,
                         bool congruent, double tolerance, double maxSpeed, bool withShapeError = true);
 
+/// The outcome of a run that the safety filter blocked: not converged, with line
+/// "not converged (blocked: agents 2, 4)"; the findings are kept.
+ShapeOutcome blockedShapeOutcome(ShapeOutcome outcome, const std::string& blocked);
+
 /**
  * Whether a run measures the O(n^2) shape error at `step`: at most a 200-agent cost per step on
  * average, so every step up to 200 agents, every ceil((n/200)^2) steps beyond, and always at the
@@ -39,6 +43,9 @@ struct ShapeOutcome {
   ShapeVerdict verdict = ShapeVerdict::NotConverged;
   ShapeFindings findings;
   long convergedStep = -1;  ///< first step of the final stretch in the desired shape, -1 if none
+  /// Why the run stopped short of the shape under a safety filter ("blocked: agents 2, 4",
+  /// BlockedDetector::description()), or empty; set by blockedShapeOutcome.
+  std::string blocked;
   /// "converged to the desired shape at step K (t = T s)",
   /// "edges converged but the shape is not the desired one (shape error E m)" (with "its mirror
   /// image; " before the shape error for a mirror image), or

@@ -1,11 +1,14 @@
 #pragma once
 
+#include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "variational_formation/core/agent_neighbourhood.hpp"
 #include "variational_formation/core/manoeuvre.hpp"
 #include "variational_formation/core/scenario.hpp"
+#include "variational_formation/core/timed_safety.hpp"
 #include "variational_formation/core/variational_update.hpp"
 
 namespace vf {
@@ -28,7 +31,11 @@ namespace vf {
  * the velocity taken from the agent's own previous command (velocity form of the update,
  * doc/robots.md), so that measurement noise is never divided by h.
  *
- * Times (`now`, receive times, ages, maxAge) are in seconds on one clock of the caller's choice.
+ * Safety (a scenario with `safety:`, enableSafety): the agent keeps every other agent's newest
+ * position, not only its neighbours', and filters each step with them (TimedSafety, doc/robots.md
+ * "Safety"); it holds until it has heard every agent once.
+ *
+ * Times (`now`, receive and send times, ages, maxAge) are in seconds on one clock of the caller's choice.
  */
 class TimedAgent {
  public:
@@ -65,10 +72,24 @@ class TimedAgent {
    * Accepted if it is the first, or if its step is higher than the held one's, or if the held
    * one is older than maxAge (a neighbour back from silence, for instance after a respawn, may
    * restart from a lower step). Anything else is Outdated (a reordered or repeated message).
-   * Never changes the agent's own state.
+   * Never changes the agent's own state. With safety on, a state of any other agent of the
+   * formation is kept for the filter (with its send time `sentAt` [s], `now` if NaN), and a
+   * non-neighbour's is then Accepted (not UnknownSender).
    */
   Receipt receive(long sender, long step, const std::vector<double>& position,
-                  const std::vector<double>& previousPosition, double now);
+                  const std::vector<double>& previousPosition, double now,
+                  double sentAt = std::numeric_limits<double>::quiet_NaN());
+
+  /**
+   * Turns the safety filter on. @param scenario the agent's (with a safety block).
+   * @param maxSpeed [m/s] (timedSafetySpeed). @param handOffset [m], 0 for holonomic robots.
+   * @throws InvalidInput without a safety block or on a bad value.
+   */
+  void enableSafety(const Scenario& scenario, double maxSpeed, double handOffset);
+  /// The filter, or nullptr without safety.
+  const TimedSafety* safety() const { return safety_ ? &*safety_ : nullptr; }
+  /// Half-spaces and speed limit that bound the last tick's step (0 when it held or nothing bound).
+  int constraintsActive() const { return constraintsActive_; }
 
   /// One wall-clock tick at time `now`: q_k -> q_{k+1}, or a hold. Never blocks.
   TickResult tick(double now);
@@ -171,6 +192,9 @@ class TimedAgent {
   Command liveCommand_;
   bool haveLastGains_ = false;  // the previous move's interval gains (for the node gains)
   ManoeuvreGains lastGains_;
+  std::optional<TimedSafety> safety_;  // empty: no safety block, or not enabled
+  double tickNow_ = 0.0;                 // the current tick's time, for the filter's margins
+  int constraintsActive_ = 0;
 };
 
 }  // namespace vf

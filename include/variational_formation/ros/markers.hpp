@@ -9,6 +9,7 @@
 #include "variational_formation/AgentState.h"
 #include "variational_formation/FormationStatus.h"
 #include "variational_formation/core/monitor.hpp"
+#include "variational_formation/core/safety.hpp"
 #include "variational_formation/core/tracking.hpp"
 
 namespace vf {
@@ -34,5 +35,15 @@ FormationStatus toStatusMessage(const FormationSnapshot& snapshot);
 visualization_msgs::MarkerArray makeMarkers(const FormationSnapshot& snapshot, const Formation& formation,
                                             const std::vector<std::deque<Eigen::Vector3d>>& trails,
                                             const CommandSchedule* schedule = nullptr, double timeStep = 0.0);
+
+/**
+ * The safety filter's markers (a scenario with `safety:`), appended to `out`: per agent its safety
+ * disc of radius r/2 (a flat cylinder in 2D, a ball in 3D), coloured by how near its closest
+ * neighbour is (green at R or farther, yellow at (r + R)/2, red at r or nearer; the neighbours
+ * from a SpatialGrid, O(n)), and the obstacles (discs and boxes: flat cylinders and boxes in 2D,
+ * spheres and cubes in 3D), grey.
+ */
+void addSafetyMarkers(const FormationSnapshot& snapshot, const SafetySettings& safety,
+                      const std::vector<Obstacle>& obstacles, visualization_msgs::MarkerArray& out);
 
 }  // namespace vf

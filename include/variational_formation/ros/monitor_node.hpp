@@ -19,6 +19,8 @@
 #include "variational_formation/RecallState.h"
 #include "variational_formation/RunProgress.h"
 #include "variational_formation/core/monitor.hpp"
+#include "variational_formation/core/run_outcome.hpp"
+#include "variational_formation/core/safety_watch.hpp"
 #include "variational_formation/core/protocol/command_desk.hpp"
 #include "variational_formation/core/protocol/run_referee.hpp"
 #include "variational_formation/core/protocol/timed_referee.hpp"
@@ -119,6 +121,22 @@ class MonitorNode {
   /// Publishes one completed step's status and markers (and /clock), stamped `stamp`; tracks the
   /// congruent stretch for the result. @return what was published, for the recorder gate.
   Published publishSnapshot(const FormationSnapshot& s, const ros::Time& stamp, double dataAge, bool noetherHolds);
+  // The safety filter as the monitor sees it (src/ros/monitor_safety.cpp, doc/ros_api.md
+  // "monitor"): min_separation and constraints_active in every status, the closest approach and
+  // filter_active_steps in the result file, and a blocked formation ends the run.
+  /// ~blocked_after, and the watch (a scenario with `safety:` only).
+  void setUpSafety(ros::NodeHandle& pnh, bool timed);
+  /// An accepted state's constraints_active.
+  void noteSafety(int agent, const AgentState& msg);
+  /// Fills the status's min_separation and constraints_active. @return the formation is blocked
+  /// (it has just become so: the run ends).
+  bool watchSafety(const FormationSnapshot& s, FormationStatus& status);
+  /// The result file's safety lines (empty without a safety block).
+  std::string safetyResultLines() const;
+  /// "blocked: agents 2, 4" once the safety filter has blocked the formation, else empty
+  /// (shapeVerdict then says "not converged (blocked: …)").
+  std::string blockedBy() const;
+
   /// Publishes `progress` (its header stamped with the completed step's simulated time).
   void publishProgress(const RunProgress& progress);
   /// Agent `agent` was heard (from `publisher`: its node or its manager).
@@ -186,6 +204,7 @@ class MonitorNode {
   Positions lastPositions_;
   double lastScale_ = 1.0;
   int exitStatus_ = -1;
+  std::unique_ptr<SafetyWatch> safety_;  // a scenario with `safety:` only
 };
 
 /**

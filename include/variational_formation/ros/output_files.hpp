@@ -27,4 +27,11 @@ void announceReplacedResult(const std::string& path);
  */
 void replaceEarlierBag(const std::string& path);
 
+/**
+ * Appends `lines` to the run's result file at `path` once the monitor has written its result
+ * there (a world's or robot's lines, e.g. contacts). @return false if it has not yet, or on an
+ * error writing.
+ */
+bool appendToResult(const std::string& path, const std::string& lines);
+
 }  // namespace vf

@@ -46,6 +46,10 @@ using variational_formation::RunProgress;
  * one tick with the scenario's delay margin (checkRobotLag): a WARN if the lag exceeds it with
  * odometry feedback, else one INFO line (with integrated feedback the margin does not bound it).
  *
+ * Safety (a scenario with `safety:`, doc/robots.md "Safety"): the agent subscribes to every
+ * agent's state, not only its neighbours', and filters each step (TimedSafety), widening r by
+ * the age of each state (from its stamp) times the max speed.
+ *
  * Diagnostics on /diagnostics (diagnostic_updater, about 1 Hz): step rate, each neighbour's age,
  * accepted and dropped states, injected losses, held ticks; WARN while holding.
  *
@@ -78,6 +82,10 @@ class TimedAgentNode {
   void publish();
   void sendCommand();
   void setUpRobot(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Scenario& scenario, int id);
+  /// The safety filter (a scenario with `safety:`): its max speed and hand offset.
+  void setUpSafety(const Scenario& scenario);
+  /// When a state was sent, on now()'s clock [s] (NaN: unknown, the receive time counts).
+  double sentAt(const AgentState& state) const;
   void reportWaiting();
   void drop(const std::string& why);
   void recover();
@@ -96,7 +104,7 @@ class TimedAgentNode {
   std::unique_ptr<LinkFaults<Received>> faults_;
   ros::Publisher statePub_, posePub_, setpointPub_, cmdVelPub_;
   std::vector<ros::Subscriber> subs_;
-  std::vector<std::string> neighbourOwners_;  // full node names, indexed like neighbourIds()
+  std::map<int, std::string> owners_;  // full node names of the agents it hears (neighbours; all with safety)
   std::map<int, AgentState> newest_;          // each neighbour's newest accepted state, for ~recall
   ros::Subscriber progressSub_, odomSub_, commandSub_, formationParametersSub_;
   std::size_t commandsSeen_ = 0;
