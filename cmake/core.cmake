@@ -40,6 +40,7 @@ add_library(variational_formation_core
   src/core/safety_filter.cpp
   src/core/safety_validation.cpp
   src/core/safety_stage.cpp
+  src/core/sensing_board.cpp
   src/core/blocked_detector.cpp
   src/core/run_tracker.cpp
   src/core/protocol/recovery.cpp
