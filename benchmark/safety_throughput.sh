@@ -7,7 +7,7 @@
 source "$(dirname "${BASH_SOURCE[0]}")/../scripts/common.sh"
 counts=("$@"); [ ${#counts[@]} -eq 0 ] && counts=(1000)
 rate() {  # steps/s of one nodelet run of $1 agents, with make_scenario flags $2
-  VF_BENCH_MODES=nodelet VF_BENCH_MAKE_FLAGS="$2" "$REPO/scripts/benchmark_ros.sh" "$1" 2>/dev/null |
+  VF_BENCH_MODES=nodelet VF_BENCH_MAKE_FLAGS="$2" "$REPO/scripts/benchmark_ros.sh" "$1" |
     awk -v n="$1" '$1 == n && $2 == "nodelet" { print $4; exit }'
 }
 echo "| agents | steps/s, safety off | steps/s, safety on | on / off |"
