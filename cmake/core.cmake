@@ -45,6 +45,7 @@ add_library(variational_formation_core
   src/core/safety_stage.cpp
   src/core/timed_safety.cpp
   src/core/safety_watch.cpp
+  src/core/sensing_board.cpp
   src/core/blocked_detector.cpp
   src/core/run_tracker.cpp
   src/core/protocol/recovery.cpp

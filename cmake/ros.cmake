@@ -12,7 +12,7 @@ target_sources(variational_formation_ros PRIVATE src/ros/lockstep_monitor.cpp sr
   src/ros/monitor_parameters.cpp src/ros/timed_monitor.cpp src/ros/monitor_outputs.cpp
   src/ros/monitor_shape.cpp src/ros/monitor_goals.cpp src/ros/goal_server.cpp src/ros/monitor_safety.cpp
   src/ros/recorder_bag.cpp src/ros/recorder_commands.cpp
-  src/ros/service_call.cpp src/ros/state_batch.cpp src/ros/periodic_call.cpp)
+  src/ros/sensing_hub.cpp src/ros/service_call.cpp src/ros/state_batch.cpp src/ros/periodic_call.cpp)
 add_dependencies(variational_formation_ros ${PROJECT_NAME}_gencfg)
 # catkin's include path is given to each ROS target privately (never exported: catkin_lint).
 target_include_directories(variational_formation_ros SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
@@ -108,6 +108,11 @@ if(CATKIN_ENABLE_TESTING)
   add_rostest(test/ros/render.test ARGS kind:=robots)
   # SIGKILL to the nodelet manager of every agent during a recorded run: test/ros/nodelet_fault.test.
   add_rostest(test/ros/nodelet_fault.test ARGS seed:=3)
+  # Lockstep with the safety filter on (test/ros/safety_run.test, doc/distributed.md "Sensing"):
+  # the bag equals simulate, unpaced, and with a SIGKILL while the victim's filter binds.
+  add_rostest(test/ros/safety_run.test ARGS rate:=0)
+  add_rostest(test/ros/safety_run.test ARGS fault:=kill)
+  add_rostest(test/ros/safety_run.test ARGS fault:=kill nodelet:=true)
   # live_tf: tf lookups at now() during a default run (/clock, /use_sim_time).
   foreach(t two_formations two_teams launch live_tf)
     add_rostest(test/ros/${t}.test)

@@ -22,7 +22,8 @@
 # environment: VF_BENCH_MODES (default "process nodelet"), VF_BENCH_STEPS (steps per run;
 #   default max(600, 120000 / agents), about 10-40 s per run), VF_BENCH_TIMEOUT (s per run,
 #   default 900), VF_BENCH_SAMPLE (s between samples, default 0.5), VF_BENCH_RECORD (1: record and
-#   check exactness; default 0).
+#   check exactness; default 0), VF_BENCH_PORT_BASE and VF_BENCH_PORTS (the masters' port range,
+#   default 11500 and 100), VF_BENCH_MAKE_FLAGS (more make_scenario flags, e.g. "--safety 0.25 1 0.2").
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 vf_install_dependencies
 vf_build
@@ -103,13 +104,13 @@ for n in "${counts[@]}"; do
   steps="${VF_BENCH_STEPS:-$(( 120000 / n > 600 ? 120000 / n : 600 ))}"
   scenario="$tmp/ring$n.yaml"
   rosrun variational_formation make_scenario --shape ring --agents "$n" --perturb 0.05 --seed 1 \
-    --steps "$steps" --name "ring$n" --out "$scenario"
+    --steps "$steps" --name "ring$n" --out "$scenario" ${VF_BENCH_MAKE_FLAGS:-}
   for m in "${modes[@]}"; do
     if [ -n "${skip[$m]:-}" ]; then
       row "$n" "$m" "$steps" n/a n/a n/a n/a n/a n/a
       continue
     fi
-    port="$(vf_free_port 11500 100)"
+    port="$(vf_free_port "${VF_BENCH_PORT_BASE:-11500}" "${VF_BENCH_PORTS:-100}")"
     log="$tmp/log_${m}_$n" samples="$tmp/samples_${m}_$n"
     : >"$samples"
     extra=()

@@ -7,7 +7,7 @@
 
 namespace vf {
 
-LockstepAgent::LockstepAgent(const Scenario& scenario, int id, StartMethod start)
+LockstepAgent::LockstepAgent(const Scenario& scenario, int id, StartMethod start, std::shared_ptr<SensingBoard> board)
     : scenario_(scenario),
       neighbourhood_(scenario, id),  // checks the id
       coefficients_(scenario.timeStep, scenario.dampingGain),
@@ -22,6 +22,26 @@ LockstepAgent::LockstepAgent(const Scenario& scenario, int id, StartMethod start
     manoeuvre_ = std::make_unique<ManoeuvreModel>(coefficients_,
                                                   scheduleFromSegments(scenario.manoeuvre, scenario.timeStep));
   }
+  if (scenario.safety) {
+    board_ = board ? std::move(board)
+                   : std::make_shared<SensingBoard>(scenario.agentCount(), dimension_, scenario.safety->sensingRadius);
+    if (board_->agentCount() != scenario.agentCount() || board_->dimension() != dimension_) {
+      throw InvalidInput("sensing: a board of " + std::to_string(board_->agentCount()) + " agents for a formation of " +
+                         std::to_string(scenario.agentCount()));
+    }
+    offerOwn();
+  }
+}
+
+bool LockstepAgent::isNeighbour(long j) const {
+  for (int k : neighbourIds()) {
+    if (k == j) return true;
+  }
+  return false;
+}
+
+void LockstepAgent::offerOwn() {
+  if (board_ && finite()) board_->offer(id_, step_, q_.data(), qPrev_.data());
 }
 
 LockstepAgent::CommandReceipt LockstepAgent::receiveCommand(long step, const Command& command, std::string* error) {
@@ -63,6 +83,22 @@ std::string LockstepAgent::describe(Receipt receipt) {
 LockstepAgent::Receipt LockstepAgent::receive(long sender, long step,
                                               const std::vector<double>& position,
                                               const std::vector<double>& previousPosition) {
+  if (board_ && sender != id_ && sender >= 0 && sender < scenario_.agentCount() && !isNeighbour(sender)) {
+    // A sensed agent (doc/distributed.md, "Sensing"): the barrier keeps it within one step, as
+    // a neighbour.
+    if (position.size() != static_cast<std::size_t>(dimension_) ||
+        previousPosition.size() != static_cast<std::size_t>(dimension_)) {
+      return Receipt::WrongDimension;
+    }
+    if (step > step_ + 1) return Receipt::ImpossibleStep;
+    switch (board_->offer(sender, step, position.data(), previousPosition.data())) {
+      case SensingBoard::Offer::Accepted: return Receipt::Accepted;
+      case SensingBoard::Offer::Duplicate: return Receipt::Duplicate;
+      case SensingBoard::Offer::UnknownSender: return Receipt::UnknownSender;
+      case SensingBoard::Offer::NonFinite: return Receipt::NonFinite;
+      case SensingBoard::Offer::GoesBack: return Receipt::ImpossibleStep;
+    }
+  }
   switch (neighbourhood_.check(sender, position, previousPosition)) {
     case AgentNeighbourhood::StateCheck::UnknownSender: return Receipt::UnknownSender;
     case AgentNeighbourhood::StateCheck::WrongDimension: return Receipt::WrongDimension;
@@ -77,6 +113,7 @@ LockstepAgent::Receipt LockstepAgent::receive(long sender, long step,
   held.step = step;
   held.position = position;
   held.previousPosition = previousPosition;
+  if (board_) board_->offer(sender, step, position.data(), previousPosition.data());
   return Receipt::Accepted;
 }
 
@@ -94,6 +131,7 @@ bool LockstepAgent::holdsNeighbourStep(int j) const {
 bool LockstepAgent::neighbourState(int j, long& step, std::vector<double>& position,
                                    std::vector<double>& previousPosition) const {
   if (j < 0 || j >= static_cast<int>(neighbours_.size())) return false;
+  if (board_ && j != id_ && !isNeighbour(j)) return board_->newest(j, step, position, previousPosition);
   const NeighbourState& s = neighbours_[static_cast<std::size_t>(j)];
   if (s.step < 0) return false;
   step = s.step;
@@ -106,7 +144,21 @@ bool LockstepAgent::ready() const {
   for (int j : neighbourIds()) {
     if (!neighbourPositionAtStep(neighbours_[static_cast<std::size_t>(j)])) return false;
   }
-  return true;
+  return !board_ || board_->complete(step_);
+}
+
+std::vector<int> LockstepAgent::missingSensed(std::size_t limit) const {
+  return board_ ? board_->missing(step_, limit) : std::vector<int>{};
+}
+
+// doc/maths.md §10, as SafetyStage::apply: after the update, from q_k and the sensed q_j^k.
+void LockstepAgent::filter(double* next) {
+  previousConstraintsActive_ = constraintsActive_;
+  if (!board_) return;
+  board_->sensed(id_, step_, sensed_);
+  filterNextPosition(*scenario_.safety, coefficients_.timeStep, dimension_, q_.data(), next, sensed_,
+                     scenario_.obstacles, safeStep_);
+  constraintsActive_ = static_cast<int>(safeStep_.projection.active.size());
 }
 
 void LockstepAgent::advance() {
@@ -122,11 +174,13 @@ void LockstepAgent::advance() {
     variationalStep(coefficients_, start_, step_, dimension_, qPrev_.data(), q_.data(),
                     neighbourhood_.initialVelocity().data(), gradient, next.data());
   }
+  filter(next.data());
   qBeforePrev_.swap(qPrev_);
   qPrev_.swap(q_);
   q_.swap(next);
   ++step_;
   advanced_ = true;
+  offerOwn();
 }
 
 // doc/maths.md §9, as in ManoeuvreIntegrator::step.
@@ -160,6 +214,8 @@ void LockstepAgent::resume(long step, const std::vector<double>& position,
   qPrev_ = previousPosition;
   qBeforePrev_ = previousPosition;
   advanced_ = false;
+  constraintsActive_ = 0;
+  offerOwn();
 }
 
 bool LockstepAgent::finite() const {
@@ -174,6 +230,7 @@ void LockstepAgent::undo() {
   q_.swap(qPrev_);
   qPrev_.swap(qBeforePrev_);
   --step_;
+  constraintsActive_ = previousConstraintsActive_;
 }
 
 }  // namespace vf

@@ -18,6 +18,7 @@
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/ros/node_main.hpp"
 #include "variational_formation/ros/parameters.hpp"
+#include "variational_formation/ros/sensing_hub.hpp"
 #include "variational_formation/ros/state_batch.hpp"
 
 namespace {
@@ -69,7 +70,10 @@ int main(int argc, char** argv) {
     // One message per step with all of its agents' states, for the monitor and the recorder.
     vf::StateBatch::start(pnh, ids);
     struct StopBatch {
-      ~StopBatch() { vf::StateBatch::stop(); }  // after the loader (declared below) unloaded the agents
+      ~StopBatch() {  // after the loader (declared below) unloaded the agents
+        vf::SensingHub::stop();
+        vf::StateBatch::stop();
+      }
     } stopBatch;
     // The agents' callbacks run on this process's own threads, one per ~num_worker_threads (0:
     // one per core, as nodelet counts), not on nodelet's queue manager.

@@ -1,19 +1,34 @@
 #include "variational_formation/ros/agent_node.hpp"
 
 #include <algorithm>
+#include <functional>
 
 #include <ros/callback_queue.h>
 
 #include "variational_formation/core/validation.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/sensing_hub.hpp"
 #include "variational_formation/ros/state_batch.hpp"
 
 namespace vf {
 
 namespace {
 constexpr double kReportEvery = 5.0;  // seconds between "waiting for ..." lines
-}
+
+/// A function, called once on the queue it is added to.
+class QueuedCall : public ros::CallbackInterface {
+ public:
+  explicit QueuedCall(std::function<void()> f) : f_(std::move(f)) {}
+  CallResult call() override {
+    f_();
+    return Success;
+  }
+
+ private:
+  std::function<void()> f_;
+};
+}  // namespace
 
 AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   const int id = requiredParam<int>(pnh, "id");
@@ -22,15 +37,17 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   monitor_ = participantName(nh, optionalParam<std::string>(pnh, "monitor", "monitor"));
   const Scenario scenario = sharedScenario(path);
   validateRealTimeFactor(realTimeFactor_, scenario.timeStep, "~real_time_factor");
-  agent_ = std::make_unique<LockstepAgent>(scenario, id);
+  managers_ = agentManagers(nh, pnh);
+  const std::shared_ptr<SensingBoard> board = SensingHub::board(nh, scenario, managers_);
+  sharedBoard_ = board != nullptr;
+  agent_ = std::make_unique<LockstepAgent>(scenario, id, StartMethod::Variational, board);
   name_ = "agent_" + std::to_string(id);
   // Frames carry the namespace, so that two formations side by side have distinct frames.
   const std::string ns = framePrefix(nh);
   frame_ = ns + name_;
   worldFrame_ = worldFrame(pnh);
-  managers_ = agentManagers(nh, pnh);
   statePub_ = nh.advertise<AgentState>(name_ + "/state", 1000, /*latch=*/true);
-  for (int j : agent_->neighbourIds()) neighbourOwners_.push_back(agentNodeName(nh, j));
+  for (int j = 0; j < scenario.agentCount(); ++j) owners_.push_back(agentNodeName(nh, j));
   neighbourHistory_.resize(agent_->neighbourIds().size());
   // Served from the start, so that restarting neighbours can ask; the subscriptions wait for
   // start(), which resumes the agent before any state reaches it.
@@ -41,6 +58,34 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
            name_.c_str(), scenario.name.c_str(), path.c_str(), static_cast<int>(agent_->neighbourIds().size()),
            scenario.dampingGain, scenario.timeStep, scenario.steps, scenario.steps == 0 ? " (unbounded)" : "",
            realTimeFactor_, monitor_.c_str());
+  if (scenario.safety) {
+    ROS_INFO("%s: safety filter on (r %g, sensing radius %g); every agent's state from %s", name_.c_str(),
+             scenario.safety->radius, scenario.safety->sensingRadius,
+             sharedBoard_ ? "the manager's shared board" : "its own topic");
+  }
+}
+
+AgentNode::~AgentNode() { *alive_ = false; }
+
+std::vector<int> AgentNode::sources() const {
+  if (!agent_->board() || sharedBoard_) return agent_->neighbourIds();
+  std::vector<int> all;
+  for (int j = 0; j < agent_->scenario().agentCount(); ++j) {
+    if (j != agent_->id()) all.push_back(j);
+  }
+  return all;
+}
+
+void AgentNode::wakeWhenSensed() {
+  if (!sharedBoard_ || wakeStep_ == agent_->step()) return;
+  wakeStep_ = agent_->step();
+  ros::CallbackQueueInterface* queue = nh_.getCallbackQueue();
+  const std::shared_ptr<bool> alive = alive_;
+  agent_->board()->whenComplete(agent_->step(), [this, queue, alive] {
+    queue->addCallback(boost::make_shared<QueuedCall>([this, alive] {
+      if (*alive) tryAdvance();
+    }), reinterpret_cast<uint64_t>(this));
+  });
 }
 
 void AgentNode::drop(const std::string& why) {
@@ -51,9 +96,7 @@ void AgentNode::drop(const std::string& why) {
 void AgentNode::onNeighbourState(int neighbour, const ros::MessageEvent<AgentState const>& event) {
   try {
     const AgentState& msg = *event.getConstMessage();
-    std::size_t k = 0;
-    while (agent_->neighbourIds()[k] != neighbour) ++k;
-    if (!fromAgent(event, neighbourOwners_[k], managers_)) {
+    if (!fromAgent(event, owners_[static_cast<std::size_t>(neighbour)], managers_)) {
       drop("a state on agent_" + std::to_string(neighbour) + "'s topic from " + event.getPublisherName() +
            ", which does not own it");
       return;
@@ -61,7 +104,9 @@ void AgentNode::onNeighbourState(int neighbour, const ros::MessageEvent<AgentSta
     const long sender = static_cast<long>(msg.id) == neighbour ? neighbour : -1;
     const auto receipt = agent_->receive(sender, msg.step, msg.position, msg.previous_position);
     if (receipt == LockstepAgent::Receipt::Accepted) {
-      neighbourHistory_[k].push_back(event.getConstMessage());
+      const std::vector<int>& ids = agent_->neighbourIds();
+      const auto k = static_cast<std::size_t>(std::find(ids.begin(), ids.end(), neighbour) - ids.begin());
+      if (k < ids.size()) neighbourHistory_[k].push_back(event.getConstMessage());
       tryAdvance();
     } else if (receipt != LockstepAgent::Receipt::Duplicate) {
       drop("a state from agent_" + std::to_string(neighbour) + " (step " + std::to_string(msg.step) +
@@ -105,7 +150,11 @@ void AgentNode::onProgress(const ros::MessageEvent<RunProgress const>& event) {
 
 void AgentNode::tryAdvance() {
   while (exitStatus_ < 0 && failure_.empty() && !agent_->finished() && agent_->step() < allowedStep_ &&
-         commandsHeld_ >= commandsCounted_ && agent_->ready()) {
+         commandsHeld_ >= commandsCounted_) {
+    if (!agent_->ready()) {
+      wakeWhenSensed();
+      return;
+    }
     const ros::WallTime now = ros::WallTime::now();
     if (!started_) {
       started_ = true;
@@ -150,6 +199,7 @@ void AgentNode::publish() {
   msg.position = agent_->position();
   msg.previous_position = agent_->previousPosition();
   msg.dropped = static_cast<uint32_t>(dropped_);
+  msg.constraints_active = static_cast<uint32_t>(agent_->constraintsActive());
   msg.failure = failure_;
   const AgentState::ConstPtr published = state;
   statePub_.publish(published);
@@ -175,6 +225,10 @@ std::string AgentNode::waitingFor() const {
   for (int j : agent_->neighbourIds()) {
     if (!agent_->holdsNeighbourStep(j)) missing += (missing.empty() ? "" : ", ") + std::string("agent_") + std::to_string(j);
   }
+  if (missing.empty()) {  // with safety: every agent's state at the step (doc/distributed.md, "Sensing")
+    for (int j : agent_->missingSensed(5)) missing += (missing.empty() ? "" : ", ") + std::string("agent_") + std::to_string(j);
+    if (!missing.empty()) missing += " (sensing)";
+  }
   return missing.empty() ? "its pacing timer" : "the state at step " + std::to_string(agent_->step()) + " of " + missing;
 }
 
@@ -187,7 +241,9 @@ void AgentNode::reportWaiting() {
 }
 
 AgentNode::Recovery AgentNode::askHolders() const {
-  return recallNewest(nh_, agent_->id(), agent_->neighbourIds(), monitor_);
+  // With an own board every agent holds our newest state: one that used our last step may be
+  // ahead of the neighbours and the monitor (doc/distributed.md, "Sensing").
+  return recallNewest(nh_, agent_->id(), sources(), monitor_);
 }
 
 void AgentNode::resume(const Recovery& r) {
@@ -235,7 +291,7 @@ bool AgentNode::onHistory(RecallHistory::Request& request, RecallHistory::Respon
 void AgentNode::start(const Recovery& recovery) {
   resume(recovery);
   subscribeToFormation(
-      nh_, agent_->neighbourIds(), 1000,
+      nh_, sources(), 1000,
       [this](int j, const ros::MessageEvent<AgentState const>& e) { onNeighbourState(j, e); },
       [this](const ros::MessageEvent<RunProgress const>& e) { onProgress(e); }, subs_, progressSub_);
   commandSub_ = nh_.subscribe<variational_formation::FormationCommands>(

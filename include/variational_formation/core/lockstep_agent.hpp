@@ -6,7 +6,9 @@
 
 #include "variational_formation/core/manoeuvre.hpp"
 #include "variational_formation/core/agent_neighbourhood.hpp"
+#include "variational_formation/core/safety_filter.hpp"
 #include "variational_formation/core/scenario.hpp"
+#include "variational_formation/core/sensing_board.hpp"
 #include "variational_formation/core/variational_update.hpp"
 
 namespace vf {
@@ -21,16 +23,28 @@ namespace vf {
  * Neighbour states arrive as (step m, q_m, q_{m-1}). A neighbour is never more than one step
  * ahead (it needs our q_m to get past m), so a state at m = k + 1 still carries the q_k we need:
  * a lost or late message is made good by the next one.
+ *
+ * With the scenario's `safety:` block every step also goes through the safety filter
+ * (doc/maths.md §10) with the agents within the sensing radius, as SafetyStage applies it: the
+ * agent then also takes states of non-neighbours, keeps every agent's newest state on a
+ * SensingBoard, and is ready only once the board holds every agent's q_k (doc/distributed.md,
+ * "Sensing").
  */
 class LockstepAgent {
  public:
   /// What became of a received neighbour state.
   enum class Receipt { Accepted, Duplicate, UnknownSender, WrongDimension, NonFinite, ImpossibleStep };
 
-  /// @throws InvalidInput if id is not an agent of the (validated) scenario.
-  LockstepAgent(const Scenario& scenario, int id, StartMethod start = StartMethod::Variational);
+  /**
+   * @param board with `safety:`, the board to share with other agents of this process (one per
+   * formation); nullptr: a board of its own. Ignored without `safety:`.
+   * @throws InvalidInput if id is not an agent of the (validated) scenario, or the board is of
+   * another size.
+   */
+  LockstepAgent(const Scenario& scenario, int id, StartMethod start = StartMethod::Variational,
+                std::shared_ptr<SensingBoard> board = nullptr);
 
-  /// Offers neighbour `sender`'s state at step m (q_m, q_{m-1}); never changes the agent's own
+  /// Offers neighbour `sender`'s state (with `safety:`, any other agent's) at step m (q_m, q_{m-1}); never changes the agent's own
   /// state, and keeps nothing unless the state is Accepted.
   Receipt receive(long sender, long step, const std::vector<double>& position,
                   const std::vector<double>& previousPosition);
@@ -51,11 +65,12 @@ class LockstepAgent {
   /// The commands this agent holds (empty without a manoeuvre).
   const CommandSchedule& commands() const;
 
-  /// Every neighbour's q_k is known.
+  /// Every neighbour's q_k is known (and, with `safety:`, every agent's).
   bool ready() const;
   /// Neighbour j's q_k is known.
   bool holdsNeighbourStep(int j) const;
-  /// The newest state received from neighbour j (for a restarted neighbour to recover from).
+  /// The newest state received from neighbour j (with `safety:`, from any agent j) (for a
+  /// restarted agent to recover from).
   /// @return false if none is held.
   bool neighbourState(int j, long& step, std::vector<double>& position, std::vector<double>& previousPosition) const;
   /// q_k -> q_{k+1}. Requires ready().
@@ -70,6 +85,14 @@ class LockstepAgent {
   bool finite() const;
   /// Back to the state before the last advance() (to report a non-finite step without it).
   void undo();
+
+  /// With `safety:`: the agents whose q_k the board lacks, ascending (at most `limit`); else empty.
+  std::vector<int> missingSensed(std::size_t limit) const;
+  /// The board (nullptr without `safety:`).
+  const std::shared_ptr<SensingBoard>& board() const { return board_; }
+  /// How many half-spaces bound the filtered step that produced q_k (0 without `safety:`, at
+  /// step 0 and after a resume, which does not know it).
+  int constraintsActive() const { return constraintsActive_; }
 
   int id() const { return id_; }
   long step() const { return step_; }
@@ -93,6 +116,11 @@ class LockstepAgent {
   void manoeuvreStep(double* next);
   /// Neighbour's q_k if held, else nullptr.
   const double* neighbourPositionAtStep(const NeighbourState& s) const;
+  bool isNeighbour(long j) const;
+  /// Filters q_{k+1} (`next`) with the agents the board senses at k (doc/maths.md §10).
+  void filter(double* next);
+  /// Puts its own q_k on the board.
+  void offerOwn();
 
   Scenario scenario_;
   // The formation as this agent knows it: its start, neighbours, the checks of a neighbour's
@@ -109,6 +137,10 @@ class LockstepAgent {
   // Set once the agent has a command (the scenario's manoeuvre, or a received one); until then
   // advance() runs today's update unchanged.
   std::unique_ptr<ManoeuvreModel> manoeuvre_;
+  std::shared_ptr<SensingBoard> board_;  // with safety only
+  std::vector<SensedAgent> sensed_;      // reused per step
+  SafeStep safeStep_;
+  int constraintsActive_ = 0, previousConstraintsActive_ = 0;
 };
 
 }  // namespace vf

@@ -42,6 +42,10 @@ using variational_formation::RunProgress;
  * until shut down (a respawning node that exited would only be restarted); its exit status is
  * then 0 if the run finished, 1 if it failed.
  *
+ * With the scenario's `safety:` block it filters every step (doc/maths.md §10) and needs every
+ * agent's state at each step (doc/distributed.md, "Sensing"): in an agent_manager from the board
+ * the manager's agents share (SensingHub), elsewhere from every agent's state topic.
+ *
  * Topics, services and private parameters (types, defaults, meaning): doc/ros_api.md, "agent
  * (lockstep mode)", the one list (test/doc/test_docs.py keeps it in step with the code).
  */
@@ -55,6 +59,7 @@ class AgentNode {
   /// queue (the global one for a node, the nodelet's own one in a manager), one at a time.
   /// @throws InvalidInput on a missing or bad parameter or scenario.
   AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  ~AgentNode();
   /// The recall calls of crash recovery: blocks up to 2 s, touches nothing that callbacks change,
   /// so it may run on any thread.
   Recovery askHolders() const;
@@ -67,6 +72,10 @@ class AgentNode {
 
  private:
   void onNeighbourState(int neighbour, const ros::MessageEvent<AgentState const>& event);
+  /// With a shared board: tryAdvance() on this agent's queue once the board holds step k.
+  void wakeWhenSensed();
+  /// Whose states it subscribes to: its neighbours, and with an own board every other agent.
+  std::vector<int> sources() const;
   void onProgress(const ros::MessageEvent<RunProgress const>& event);
   /// The monitor's list of issued commands (src/ros/agent_commands.cpp): applies the new ones.
   void onCommands(const ros::MessageEvent<variational_formation::FormationCommands const>& event);
@@ -83,7 +92,7 @@ class AgentNode {
   std::unique_ptr<LockstepAgent> agent_;
   ros::Publisher statePub_;
   std::vector<ros::Subscriber> subs_;
-  std::vector<std::string> neighbourOwners_;  // full node names, indexed like neighbourIds()
+  std::vector<std::string> owners_;           // full node names, by agent id
   std::vector<std::string> managers_;         // ~agent_manager: nodelet managers of agents
   ros::Subscriber progressSub_, commandSub_;
   long commandsHeld_ = 0;     // commands of the monitor's list applied
@@ -106,6 +115,9 @@ class AgentNode {
   long dropped_ = 0;
   int exitStatus_ = -1;  // -1: running
   std::string name_, frame_, failure_, worldFrame_;
+  bool sharedBoard_ = false;  // the manager's board (SensingHub), not one of its own
+  long wakeStep_ = -1;        // the step a wake-up from the board is asked for
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);  // read by queued wake-ups
   // The waiting line (not a roscpp timer: one per agent of a manager is costly). Last, so that it
   // stops, and a call in progress ends, before any member it reads goes.
   PeriodicCall watch_;

@@ -39,6 +39,8 @@ class StateBatch {
 
   /// A state its agent just published; states of agents not in ~agents are left out.
   void add(const variational_formation::AgentState::ConstPtr& state);
+  /// ~agents: the agents this manager batches.
+  const std::set<int>& ids() const { return ids_; }
 
  private:
   StateBatch(ros::NodeHandle& pnh, const std::vector<int>& ids);
