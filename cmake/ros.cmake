@@ -99,6 +99,8 @@ if(CATKIN_ENABLE_TESTING)
   # robots.launch's wall-time bag: the video is the run from its first step, one name per robot.
   add_rostest(test/ros/render.test ARGS kind:=formation)
   add_rostest(test/ros/render.test ARGS kind:=robots)
+  # The same with world:=mujoco: the world's markers (bodies, headings, contacts) in the bag and video.
+  add_rostest(test/ros/render.test ARGS kind:=mujoco)
   # SIGKILL to the nodelet manager of every agent during a recorded run: test/ros/nodelet_fault.test.
   add_rostest(test/ros/nodelet_fault.test ARGS seed:=3)
   # live_tf: tf lookups at now() during a default run (/clock, /use_sim_time).
