@@ -16,7 +16,7 @@ planar MuJoCo world, a unicycle in 3D) is listed with the launch's FATAL line.
 
 usage: benchmark/world_scenarios.py [--scenarios NAME ...] [--worlds kinematic mujoco]
                                     [--kinematics holonomic unicycle] [--cap SECONDS]
-                                    [--extra SECONDS] [--port P]
+                                    [--extra SECONDS] [--port P] [--keep DIR]
 Needs the built workspace sourced (roslaunch finds the package). Prints one markdown table row
 per run.
 """
@@ -82,7 +82,7 @@ def measure(bag_path, scenario, kinematics, ends):
     return errors, len(contacts), first
 
 
-def run(name, world, kinematics, cap, extra, port, out):
+def run(name, world, kinematics, cap, extra, port, out, keep=None):
     with open(os.path.join(HERE, "..", "config", name + ".yaml")) as f:
         scenario = yaml.safe_load(f)
     h = float(scenario["time_step"])
@@ -117,7 +117,9 @@ def run(name, world, kinematics, cap, extra, port, out):
         return "| " + " | ".join(cells + [f"did not run: {fatal[0].strip() if fatal else 'no bag'}", "", "", ""]) + " |"
     errors, contacts, first = measure(bag, scenario, kinematics, [shipped, shipped + extra])
     for leftover in (bag, result_file):
-        if os.path.exists(leftover):
+        if keep and os.path.exists(leftover):
+            shutil.move(leftover, os.path.join(keep, f"{name}_{world}_{kinematics}{os.path.splitext(leftover)[1]}"))
+        elif os.path.exists(leftover):
             os.remove(leftover)
     shown = [f"{e * 1000:.2f} mm" if e is not None else "(no odometry)" for e in errors]
     contact_text = "(not simulated)" if world == "kinematic" else f"{contacts}" + (f" (first {first})" if first else "")
@@ -133,6 +135,7 @@ def main():
     parser.add_argument("--cap", type=float, default=30.0)
     parser.add_argument("--extra", type=float, default=10.0)
     parser.add_argument("--port", type=int, default=11650)
+    parser.add_argument("--keep", default=None, help="a folder to keep the bags and result files in")
     args = parser.parse_args()
     out = tempfile.mkdtemp(prefix="vf_world_scenarios_")
     print("| scenario | world | kinematics | error at the end | settled (+ extra) | result | contacts |", flush=True)
@@ -141,7 +144,7 @@ def main():
         for name in args.scenarios:
             for kinematics in args.kinematics:
                 for world in args.worlds:
-                    print(run(name, world, kinematics, args.cap, args.extra, args.port, out), flush=True)
+                    print(run(name, world, kinematics, args.cap, args.extra, args.port, out, args.keep), flush=True)
     finally:
         shutil.rmtree(out, ignore_errors=True)
     return 0

@@ -95,6 +95,12 @@ if(CATKIN_ENABLE_TESTING)
     "case:=ring7_unicycle_lag03 scenario:=ring7 lag:=0.3 kinematics:=unicycle heading_seed:=5 time_limit:=90 expect_lag_warning:=true"
     "case:=mujoco_unicycle world:=mujoco kinematics:=unicycle heading_seed:=7"
     "case:=mujoco_holonomic world:=mujoco")
+  # TODO(issue 33, item 6): "with the safety filter on, unicycles from scattered starts end with 0
+  # contacts" needs the timed agents to apply the scenario's safety: block in robot mode (issue 31's
+  # robot-mode safety). Until then the agents ignore it and robots 2 and 3 collide. Once they do,
+  # register (robots_run_test.py asserts contacts: 0 and the shape in the MuJoCo world):
+  #   vf_add_rostest_cases(test/ros/robots_run.test "case:=mujoco_safety_scattered world:=mujoco
+  #     kinematics:=unicycle scenario_dir:=test/ros scenario:=scattered6_safety time_limit:=90")
   # render_bag.py on a recorded hexagon: video length, frames, processes left, bad inputs; and on
   # robots.launch's wall-time bag: the video is the run from its first step, one name per robot.
   add_rostest(test/ros/render.test ARGS kind:=formation)
