@@ -592,6 +592,8 @@ def render(args, procs, tmp, progress):
         copy = os.path.join(tmp, "run.bag")
         run.write_on_run_time(contents, topics, copy)
         contents = BagContents([copy])
+        # rosbag record may have joined a topic (the world's markers) only after the shown span.
+        topics = [t for t in topics if t in contents.topics]
     first, span = run.first, run.last - run.first
     scene = Scene(contents, markers, first, first + span)
     config = os.path.join(tmp, "formation.rviz")
