@@ -99,13 +99,17 @@ if(CATKIN_ENABLE_TESTING)
     "case:=mujoco_unicycle world:=mujoco kinematics:=unicycle heading_seed:=7"
     "case:=mujoco_holonomic world:=mujoco"
     # Unicycles from scattered starts with the safety filter (doc/robots.md, "Safety"): no contact.
-    "case:=scatter6_unicycle_safety scenario:=${PROJECT_SOURCE_DIR}/test/ros/scatter6_safety.yaml kinematics:=unicycle heading_seed:=3 time_limit:=90")
+    "case:=scatter6_unicycle_safety scenario:=${PROJECT_SOURCE_DIR}/test/ros/scatter6_safety.yaml kinematics:=unicycle heading_seed:=3 time_limit:=90"
+    # The same in the MuJoCo world, where bodies really touch: 0 contacts (issue 33).
+    "case:=mujoco_safety_scattered world:=mujoco kinematics:=unicycle scenario_dir:=test/ros scenario:=scattered6_safety time_limit:=90")
   # The monitor's safety report on a formation the filter blocks (closest approach, blocked).
   add_rostest(test/ros/safety_monitor.test)
   # render_bag.py on a recorded hexagon: video length, frames, processes left, bad inputs; and on
   # robots.launch's wall-time bag: the video is the run from its first step, one name per robot.
   add_rostest(test/ros/render.test ARGS kind:=formation)
   add_rostest(test/ros/render.test ARGS kind:=robots)
+  # The same with world:=mujoco: the world's markers (bodies, headings, contacts) in the bag and video.
+  add_rostest(test/ros/render.test ARGS kind:=mujoco)
   # SIGKILL to the nodelet manager of every agent during a recorded run: test/ros/nodelet_fault.test.
   add_rostest(test/ros/nodelet_fault.test ARGS seed:=3)
   # Lockstep with the safety filter on (test/ros/safety_run.test, doc/distributed.md "Sensing"):

@@ -38,7 +38,7 @@ target_link_libraries(world_step_response variational_formation_world variationa
 target_compile_options(world_step_response PRIVATE ${VF_FLAGS})
 install(TARGETS world_step_response RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
-add_executable(mujoco_world src/ros/mujoco_world_main.cpp src/ros/mujoco_world_node.cpp)
+add_executable(mujoco_world src/ros/mujoco_world_main.cpp src/ros/mujoco_world_node.cpp src/ros/world_markers.cpp)
 target_include_directories(mujoco_world SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(mujoco_world variational_formation_ros variational_formation_world ${catkin_LIBRARIES})
 target_compile_options(mujoco_world PRIVATE ${VF_FLAGS})
@@ -54,6 +54,11 @@ if(CATKIN_ENABLE_TESTING)
     target_compile_options(test_${name} PRIVATE ${VF_FLAGS})
     target_compile_definitions(test_${name} PRIVATE VF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   endforeach()
+  # The world's rviz markers, a function of the world (no master).
+  catkin_add_gtest(test_world_markers test/world/test_world_markers.cpp src/ros/world_markers.cpp)
+  target_include_directories(test_world_markers SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
+  target_link_libraries(test_world_markers variational_formation_ros variational_formation_world gtest_main)
+  target_compile_options(test_world_markers PRIVATE ${VF_FLAGS})
 endif()
 
 # Its real-time factor against the robot count, for the checkout only (like benchmark_roa).

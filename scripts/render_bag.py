@@ -36,6 +36,7 @@ FORMATS = (".mp4", ".gif")
 TOOLS = {"ffmpeg": "ffmpeg", "ffprobe": "ffmpeg", "Xvfb": "xvfb", "rviz": "rviz", "rosbag": "python3-rosbag",
          "rosmaster": "python3-rosmaster"}  # each with its Debian package
 MARKERS = "/formation/markers"  # the topic config/formation.rviz shows, below a team's namespace
+WORLD_MARKERS = "/formation/world/markers"  # a MuJoCo world's bodies, headings and contacts (display World)
 TF_SCALE = 8.0  # tf axes and names: this many sphere radii
 AGENT_FRAME = re.compile(r"(^|/)formation/agent_\d+$")  # an agent's tf frame, below any team namespace
 FIT_DISTANCE = 3.0  # camera distance over the formation's reach (half the box's diagonal)
@@ -156,7 +157,8 @@ class BagContents:
 
 
 def choose_topics(contents, ns):
-    """(namespace prefix, markers topic or None, odometry topics, every topic to replay)."""
+    """(namespace prefix, markers topic or None, odometry topics, every topic to replay). A MuJoCo
+    world's markers, where the bag has them, are replayed too (world_markers)."""
     teams = contents.teams()
     if ns is not None:
         prefix = "/" + ns.strip("/") if ns.strip("/") else ""
@@ -171,11 +173,18 @@ def choose_topics(contents, ns):
     # The robots' odometry (robots.launch), shown only where the bag has no markers to show.
     odometry = [] if markers else sorted(t for t, kind in contents.topics.items()
                                          if kind == "nav_msgs/Odometry" and t.startswith(prefix + "/formation/"))
-    replay = [t for t in (markers, "/tf", "/tf_static") if t in contents.topics] + odometry
+    replay = [t for t in (markers, world_markers(contents, prefix), "/tf", "/tf_static") if t in contents.topics]
+    replay += odometry
     if not markers and "/tf" not in contents.topics and not odometry:
         fail(f"nothing in the bag that rviz shows: no {prefix}{MARKERS}, /tf or robot odometry "
              f"(topics: {', '.join(sorted(contents.topics))})")
     return prefix, markers, odometry, replay
+
+
+def world_markers(contents, prefix):
+    """The MuJoCo world's markers topic of the team (robots.launch world:=mujoco), or None."""
+    topic = prefix + WORLD_MARKERS
+    return topic if topic in contents.topics else None
 
 
 def first_instant(contents, topics, first):
@@ -228,17 +237,23 @@ class Scene:
         return self.low[0] <= self.high[0]
 
 
-def rviz_config(template, markers, odometry, scene, args):
-    """config/formation.rviz for this bag: the team's markers topic, the bag's fixed frame, the
-    window at the video's size, the camera on the formation (--camera fit), tf frames drawn at the
-    formation's scale, and the robots' odometry where the bag has no markers."""
+def rviz_config(template, markers, odometry, scene, args, world=None):
+    """config/formation.rviz for this bag: the team's markers topic, the world's (`world`; its
+    display is dropped where the bag has none), the bag's fixed frame, the window at the video's
+    size, the camera on the formation (--camera fit), tf frames drawn at the formation's scale, and
+    the robots' odometry where the bag has no markers."""
     with open(template) as f:
         config = yaml.safe_load(f)
     manager = config["Visualization Manager"]
     agents = {f for f in scene.frames if AGENT_FRAME.search(f)}
     others = scene.frames - agents - {scene.fixed_frame}
     for display in list(manager["Displays"]):
-        if display.get("Class") == "rviz/MarkerArray" and markers:
+        if display.get("Class") == "rviz/MarkerArray" and display.get("Name") == "World":
+            if world:
+                display["Marker Topic"] = world
+            else:
+                manager["Displays"].remove(display)
+        elif display.get("Class") == "rviz/MarkerArray" and markers:
             display["Marker Topic"] = markers
         if display.get("Class") == "rviz/TF" and scene.radius:
             # Axes and names that stick out of the agents' spheres: the spheres' radius is a tenth
@@ -577,11 +592,14 @@ def render(args, procs, tmp, progress):
         copy = os.path.join(tmp, "run.bag")
         run.write_on_run_time(contents, topics, copy)
         contents = BagContents([copy])
+        # rosbag record may have joined a topic (the world's markers) only after the shown span.
+        topics = [t for t in topics if t in contents.topics]
     first, span = run.first, run.last - run.first
     scene = Scene(contents, markers, first, first + span)
     config = os.path.join(tmp, "formation.rviz")
     with open(config, "w") as f:
-        f.write(rviz_config(os.path.join(package_path(), "config", "formation.rviz"), markers, odometry, scene, args))
+        f.write(rviz_config(os.path.join(package_path(), "config", "formation.rviz"), markers, odometry, scene, args,
+                            world_markers(contents, prefix)))
     env = dict(os.environ, ROS_HOSTNAME="localhost", ROS_LOG_DIR=os.path.join(tmp, "log"))
     env.pop("ROS_IP", None)
     uri, master = start_master(procs, args.port, env)

@@ -8,8 +8,6 @@
 
 namespace vf {
 
-namespace {
-
 std_msgs::ColorRGBA rgba(double r, double g, double b, double a) {
   std_msgs::ColorRGBA c;
   c.r = static_cast<float>(r);
@@ -18,6 +16,8 @@ std_msgs::ColorRGBA rgba(double r, double g, double b, double a) {
   c.a = static_cast<float>(a);
   return c;
 }
+
+namespace {
 
 geometry_msgs::Point point(const Eigen::Vector3d& p) {
   geometry_msgs::Point q;

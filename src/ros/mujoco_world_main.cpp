@@ -5,7 +5,8 @@ namespace {
 const char* const kUsage =
     "usage: rosrun variational_formation mujoco_world _scenario:=FILE [_kinematics:=unicycle] [_param:=value]\n"
     "Every robot of a planar scenario in one MuJoCo world, each with robot_sim's interface in robot_<i>:\n"
-    "cmd_vel in; odom, joint_states and tf out; contacts on ~contacts. Started by\n"
+    "cmd_vel in; odom, joint_states and tf out; contacts on ~contacts, bodies, headings, obstacles\n"
+    "and contacts for rviz on ~markers. The scenario's obstacles are static geoms. Started by\n"
     "robots.launch world:=mujoco; parameters in doc/ros_api.md, the model in doc/robots.md.\n";
 }  // namespace
 

@@ -15,6 +15,7 @@
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/participants.hpp"
 #include "variational_formation/ros/world_contact.hpp"
+#include "variational_formation/ros/world_markers.hpp"
 #include "variational_formation/world/mjcf_model.hpp"
 
 namespace vf {
@@ -49,6 +50,7 @@ MujocoWorldNode::MujocoWorldNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh
   const std::string odometry = optionalParam<std::string>(pnh, "odometry", "ground_truth");
   const int headingSeed = optionalParam(pnh, "heading_seed", 0);
   const double publishRate = optionalParam(pnh, "publish_rate", 100.0);
+  const double markerRate = optionalParam(pnh, "marker_rate", 20.0);
   clock_ = optionalParam(pnh, "clock", false);
   cmdTimeout_ = optionalParam(pnh, "cmd_timeout", cmdTimeout_);
   worldFrame_ = worldFrame(pnh);
@@ -56,6 +58,7 @@ MujocoWorldNode::MujocoWorldNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh
   try {
     settings = worldSettings(pnh);
     requireFiniteAbove("publish_rate", publishRate, 0.0, "Hz");
+    requireFiniteAtLeast("marker_rate", markerRate, 0.0, "Hz");
     requireFiniteAtLeast("cmd_timeout", cmdTimeout_, 0.0, "s");
     requireFiniteAtLeast("heading_seed", headingSeed, 0.0, "");
     if (odometry != "ground_truth" && odometry != "wheels") {
@@ -75,12 +78,14 @@ MujocoWorldNode::MujocoWorldNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh
   const int count = scenario.agentCount();
   if (model.empty()) {
     const std::vector<PlanarPose> starts = worldStartPoses(scenario, settings, static_cast<std::uint64_t>(headingSeed));
-    world_ = std::make_unique<MujocoWorld>(buildWorldMjcf(settings, starts), "the scenario's world", count, settings);
+    world_ = std::make_unique<MujocoWorld>(buildWorldMjcf(settings, starts, worldObstacles(scenario)),
+                                           "the scenario's world", count, settings);
   } else {
     world_ = MujocoWorld::fromFile(model, count, settings);
   }
   realTimeFactor_ = settings.realTimeFactor;
   publishPeriod_ = 1.0 / publishRate;
+  markerPeriod_ = markerRate > 0.0 ? 1.0 / markerRate : -1.0;
   resultFile_ = outputPath(nh, optionalParam<std::string>(pnh, "result_file", ""));
   const std::string prefix = framePrefix(nh);
   robots_.resize(static_cast<std::size_t>(count));
@@ -95,6 +100,7 @@ MujocoWorldNode::MujocoWorldNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh
         ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
   }
   contactPub_ = pnh.advertise<variational_formation::WorldContact>("contacts", 100);
+  if (markerPeriod_ > 0.0) markerPub_ = pnh.advertise<visualization_msgs::MarkerArray>("markers", 10);
   if (clock_) clockPub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
   progressSub_ = nh.subscribe("progress", 10, &MujocoWorldNode::onProgress, this);
   diagnostics_.setHardwareID(prefix + "world");
@@ -185,6 +191,11 @@ void MujocoWorldNode::publish() {
     state.velocity = joints.velocity;
     state.effort = joints.effort;
     io.joints.publish(state);
+  }
+  // The bodies, headings and contacts for rviz and render_bag.py, at their own (lower) rate.
+  if (markerPeriod_ > 0.0 && world_->time() >= nextMarkers_) {
+    markerPub_.publish(makeWorldMarkers(*world_, header));
+    nextMarkers_ = world_->time() + markerPeriod_ - 0.5 * world_->settings().timeStep;
   }
 }
 

@@ -22,12 +22,13 @@ std::vector<ContactEvent> ContactLog::record(double time, const std::vector<Touc
     ++active_;
     // Bodies pressed together lose and regain touch from step to step: one contact until apart.
     if (last == lastTouched_.end() || time - last->second > kSeparation) {
-      began.push_back({time, participantName(pair.first), participantName(pair.second), t.normalForce});
+      began.push_back({time, participantName(pair.first), participantName(pair.second), t.normalForce, t.x, t.y});
     }
     lastTouched_[pair] = time;
   }
   count_ += static_cast<long>(began.size());
   if (!first_ && !began.empty()) first_ = began.front();
+  events_.insert(events_.end(), began.begin(), began.end());
   return began;
 }
 

@@ -1,5 +1,6 @@
 #include "variational_formation/world/mjcf_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -114,6 +115,31 @@ std::vector<PlanarPose> worldStartPoses(const Scenario& scenario, const WorldSet
   return starts;
 }
 
+std::vector<StaticObstacle> worldObstacles(const Scenario& scenario, double height) {
+  if (scenario.dimension != 2 && !scenario.obstacles.empty()) {
+    throw InvalidInput("dimension: the MuJoCo world is planar (obstacles on a floor), got " +
+                       std::to_string(scenario.dimension));
+  }
+  std::vector<StaticObstacle> out;
+  for (const Obstacle& o : scenario.obstacles) {
+    StaticObstacle s;
+    s.height = height;
+    if (o.shape == Obstacle::Shape::Ball) {
+      s.x = o.centre.x();
+      s.y = o.centre.y();
+      s.radius = std::max(o.radius, kMinObstacleHalfWidth);
+    } else {
+      s.shape = StaticObstacle::Shape::Box;
+      s.x = 0.5 * (o.min.x() + o.max.x());
+      s.y = 0.5 * (o.min.y() + o.max.y());
+      s.halfX = std::max(0.5 * (o.max.x() - o.min.x()), kMinObstacleHalfWidth);
+      s.halfY = std::max(0.5 * (o.max.y() - o.min.y()), kMinObstacleHalfWidth);
+    }
+    out.push_back(s);
+  }
+  return out;
+}
+
 std::string buildWorldMjcf(const WorldSettings& settings, const std::vector<PlanarPose>& starts,
                            const std::vector<StaticObstacle>& obstacles) {
   validateWorldSettings(settings);
@@ -131,7 +157,12 @@ std::string buildWorldMjcf(const WorldSettings& settings, const std::vector<Plan
     if (!std::isfinite(o.x) || !std::isfinite(o.y)) {
       throw InvalidInput(field + ": centre must be finite, got (" + n(o.x) + ", " + n(o.y) + ")");
     }
-    requireFiniteAbove(field + ".radius", o.radius, 0.0, "m");
+    if (o.shape == StaticObstacle::Shape::Box) {
+      requireFiniteAbove(field + ".half_x", o.halfX, 0.0, "m");
+      requireFiniteAbove(field + ".half_y", o.halfY, 0.0, "m");
+    } else {
+      requireFiniteAbove(field + ".radius", o.radius, 0.0, "m");
+    }
     requireFiniteAbove(field + ".height", o.height, 0.0, "m");
   }
   const int count = static_cast<int>(starts.size());
@@ -153,9 +184,13 @@ std::string buildWorldMjcf(const WorldSettings& settings, const std::vector<Plan
       << "    <geom name=\"floor\" type=\"plane\" size=\"0 0 1\" friction=\"1e-6 0.005 0.0001\"/>\n";
   for (std::size_t k = 0; k < obstacles.size(); ++k) {
     const StaticObstacle& o = obstacles[k];
-    out << "    <geom name=\"obstacle_" << k << "\" type=\"cylinder\" size=\"" << n(o.radius) << ' '
-        << n(0.5 * o.height) << "\" pos=\"" << n(o.x) << ' ' << n(o.y) << ' ' << n(0.5 * o.height)
-        << "\" friction=\"" << n(settings.friction) << " 0.005 0.0001\"/>\n";
+    const bool box = o.shape == StaticObstacle::Shape::Box;
+    out << "    <geom name=\"obstacle_" << k << "\" type=\"" << (box ? "box" : "cylinder") << "\" size=\"";
+    if (box) out << n(o.halfX) << ' ' << n(o.halfY) << ' ';
+    else out << n(o.radius) << ' ';
+    // As stiff as the robots' bodies: a robot pushed against it by its motors stops within millimetres.
+    out << n(0.5 * o.height) << "\" pos=\"" << n(o.x) << ' ' << n(o.y) << ' ' << n(0.5 * o.height)
+        << "\" friction=\"" << n(settings.friction) << " 0.005 0.0001\"" << kBodyContact << "/>\n";
   }
   for (int i = 0; i < count; ++i) {
     if (settings.kinematics == WorldKinematics::Unicycle) differentialDrive(out, settings, i, starts[i]);

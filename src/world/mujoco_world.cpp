@@ -138,6 +138,7 @@ void MujocoWorld::bind(const std::string& source, int robots) {
       r.jointNames.push_back(part);
     }
     participantOfBody_[static_cast<std::size_t>(r.body)] = i;
+    bodyGeoms_.push_back(mj_name2id(model_, mjOBJ_GEOM, (name + "_body").c_str()));
     robots_.push_back(std::move(r));
   }
   // Obstacles, numbered in the order of the model's geoms named obstacle_*.
@@ -190,6 +191,7 @@ bool MujocoWorld::setCommand(int i, double linear, double lateral, double angula
 
 std::vector<Touch> MujocoWorld::touching() const {
   std::map<std::pair<int, int>, Touch> pairs;
+  std::map<std::pair<int, int>, int> points;  // contact points per pair, for their mean
   const int robots = robotCount();
   for (int k = 0; k < data_->ncon; ++k) {
     const mjContact& c = data_->contact[k];
@@ -210,9 +212,17 @@ std::vector<Touch> MujocoWorld::touching() const {
     t.b = std::max(side[0], side[1]);
     t.normalForce += force[0];
     t.penetration = std::max(t.penetration, -c.dist);
+    t.x += c.pos[0];
+    t.y += c.pos[1];
+    ++points[{t.a, t.b}];
   }
   std::vector<Touch> out;
-  for (const auto& entry : pairs) out.push_back(entry.second);
+  for (auto& entry : pairs) {
+    const int count = points[entry.first];
+    entry.second.x /= count;
+    entry.second.y /= count;
+    out.push_back(entry.second);
+  }
   return out;
 }
 
@@ -228,7 +238,8 @@ void MujocoWorld::step() {
                        " s and MuJoCo reset it; a smaller time_step or more wheel_armature steadies it");
   }
   // The contacts and forces of this step are those of the state it started from.
-  newContacts_ = contacts_.record(before, touching());
+  touches_ = touching();
+  newContacts_ = contacts_.record(before, touches_);
   for (Robot& r : robots_) {
     if (r.odometry) r.odometry->update(jointPosition(r.joints[0]), jointPosition(r.joints[1]));
   }
@@ -286,6 +297,38 @@ std::vector<double> MujocoWorld::actuatorForces(int i) const {
   const Robot& r = robot(i);
   std::vector<double> out;
   for (int a : r.actuators) out.push_back(data_->actuator_force[a]);
+  return out;
+}
+
+BodyOutline MujocoWorld::bodyOutline(int i) const {
+  const Robot& r = robot(i);
+  refresh();
+  const int geom = bodyGeoms_[static_cast<std::size_t>(i)];
+  if (geom >= 0 && model_->geom_type[geom] == mjGEOM_CYLINDER) {
+    const mjtNum* p = data_->geom_xpos + 3 * geom;
+    return {p[0], p[1], p[2], model_->geom_size[3 * geom], model_->geom_size[3 * geom + 1]};
+  }
+  const mjtNum* p = data_->xpos + 3 * r.body;
+  return {p[0], p[1], p[2], settings_.bodyRadius, 0.04};
+}
+
+std::vector<ObstacleGeom> MujocoWorld::obstacleGeoms() const {
+  refresh();
+  std::vector<ObstacleGeom> out;
+  for (int g = 0; g < model_->ngeom; ++g) {
+    if (obstacleOfGeom_[static_cast<std::size_t>(g)] < 0) continue;
+    ObstacleGeom o;
+    switch (model_->geom_type[g]) {
+      case mjGEOM_CYLINDER: o.type = ObstacleGeom::Type::Cylinder; break;
+      case mjGEOM_BOX: o.type = ObstacleGeom::Type::Box; break;
+      case mjGEOM_SPHERE: o.type = ObstacleGeom::Type::Sphere; break;
+      default: o.type = ObstacleGeom::Type::Other; break;
+    }
+    mju_copy(o.position, data_->geom_xpos + 3 * g, 3);
+    mju_mat2Quat(o.quaternion, data_->geom_xmat + 9 * g);
+    mju_copy(o.size, model_->geom_size + 3 * g, 3);
+    out.push_back(o);
+  }
   return out;
 }
 

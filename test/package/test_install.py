@@ -100,6 +100,8 @@ class InstallTest(unittest.TestCase):
             if not checkout_only:
                 expected.add(name)
         self.assertEqual(sorted(expected - installed), [], "not installed")
+        # The MuJoCo world's node and tool (and, through their --help below, its shared library).
+        self.assertLessEqual({"mujoco_world", "world_step_response"}, installed)
         for name in ("launch/formation.launch", "launch/robots.launch", "launch/agent.launch",
                      "config/hexagon.yaml", "config/formation.rviz", "package.xml", "nodelet_plugins.xml"):
             self.assertTrue(os.path.isfile(os.path.join(self.prefix, "share", PKG, name)), name)
@@ -151,6 +153,22 @@ class InstallTest(unittest.TestCase):
             listed = self.in_install(f"roslaunch --nodes {PKG} {launch}", hide_source=hide)
             self.assertEqual(listed.returncode, 0, listed.stderr)
             self.assertIn("/formation/agent_0", listed.stdout)
+        # The MuJoCo world from the install space: robots.launch world:=mujoco starts it, and the
+        # installed node builds the hexagon's world and steps it (its parameter check, its model,
+        # libmujoco and its own library), ended by a timeout after its start-up line.
+        listed = self.in_install(f"roslaunch --nodes {PKG} robots.launch world:=mujoco", hide_source=hide)
+        self.assertEqual(listed.returncode, 0, listed.stderr)
+        self.assertIn("/formation/world", listed.stdout)
+        port = free_port()
+        world = self.in_install(
+            f"export ROS_MASTER_URI=http://localhost:{port}; roscore -p {port} >/dev/null 2>&1 & core=$!; "
+            f"status=0; timeout -s INT 10 rosrun {PKG} mujoco_world _kinematics:=unicycle "
+            f"_scenario:=$(rospack find {PKG})/config/hexagon.yaml || status=$?; "
+            f"kill -INT $core; wait $core || true; echo \"mujoco_world exit status $status\"", hide_source=hide)
+        self.assertIn("6 robots (built)", world.stdout + world.stderr, world.stderr)
+        self.assertNotIn("FATAL", world.stdout + world.stderr)
+        # Still stepping when the timeout ended it (timeout's status 124), not dead before.
+        self.assertIn("mujoco_world exit status 124", world.stdout, world.stderr)
 
 
 if __name__ == "__main__":

@@ -152,3 +152,20 @@ class RobotsBagTest(TempDirTestCase):
             axes += shown if display.get("Show Axes") else []
         self.assertEqual(sorted(named), sorted(agents + ["world"]), "the frames whose names are drawn")
         self.assertEqual(sorted(axes), sorted(agents + robots + ["world"]), "the frames whose axes are drawn")
+
+    def test_the_worlds_markers_are_shown_where_the_bag_has_them(self):
+        # robots.launch world:=mujoco records /formation/world/markers: the display World shows
+        # them (a team's topic below its namespace); a bag without them has no such display.
+        scene = self.render.Scene(self.contents, "/formation/markers", self.contents.start, self.contents.end)
+        args = argparse.Namespace(fps=25, width=640, height=480, camera="fit")
+        template = os.path.join(REPO, "config", "formation.rviz")
+
+        def marker_displays(world):
+            config = yaml.safe_load(self.render.rviz_config(template, "/team_a/formation/markers", [], scene, args,
+                                                            world))
+            return {d["Name"]: d["Marker Topic"] for d in config["Visualization Manager"]["Displays"]
+                    if d["Class"] == "rviz/MarkerArray"}
+
+        self.assertEqual(marker_displays("/team_a/formation/world/markers"),
+                         {"World": "/team_a/formation/world/markers", "Formation": "/team_a/formation/markers"})
+        self.assertEqual(marker_displays(None), {"Formation": "/team_a/formation/markers"})

@@ -16,6 +16,12 @@ step or from the step at which rosbag record joined: its video is the run from t
 recorded step (within two steps) to the last, (4.2 s - that step's t) over the speed within 1.5
 frames, not the bag's length; 90 % of the frames and the last one show every agent.
 
+With `mujoco` (render.test kind:=mujoco), the bag of robots.launch world:=mujoco with unicycles:
+the same checks, and the bag holds the world's markers at 20 Hz from when rosbag record joined them,
+a body and a heading arrow per robot in each, every arrow from the robot's odometry position along
+its heading (the same instant, to 1e-9), and the contact markers deleted (the hexagon's robots
+never touch).
+
 VF_TEST_DISPLAY=:N (optional) makes every render use X display :N, and the busy-display case
 N + 1; by default Xvfb picks free ones.
 
@@ -345,5 +351,53 @@ class RenderRobotsTest(RecordedHexagon):
         self.assertNotIn(len(frames) - 1, without, "the last frame lacks an agent")
 
 
+class RenderMujocoTest(RenderRobotsTest):
+    """RenderRobotsTest on robots.launch world:=mujoco (unicycles), plus the world's markers (its
+    setUpClass, reported as there)."""
+
+    def test_the_bag_holds_the_worlds_markers(self):
+        import rosbag
+        odom = {}  # (robot, stamp [ns]) -> (x, y, heading) of the odometry (ground truth)
+        arrays = []
+        with rosbag.Bag(self.bag) as bag:
+            for topic, msg, _ in bag.read_messages(topics=[f"/formation/robot_{i}/odom" for i in range(6)] +
+                                                   ["/formation/world/markers"]):
+                if topic.endswith("/odom"):
+                    q = msg.pose.pose.orientation
+                    odom[(int(topic.split("_")[1].split("/")[0]), msg.header.stamp.to_nsec())] = (
+                        msg.pose.pose.position.x, msg.pose.pose.position.y,
+                        np.arctan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z)))
+                else:
+                    arrays.append(msg)
+        # ~marker_rate 20 Hz from when rosbag record joined the topic (it joins topics one by one,
+        # on a loaded machine seconds apart) to the end of the recording, after the run's end.
+        stamps = sorted(a.markers[0].header.stamp.to_sec() for a in arrays)
+        self.assertGreater(stamps[-1] - stamps[0], AFTER_THE_RUN, "world markers recorded")
+        self.assertGreater(len(stamps), 0.9 * 20 * (stamps[-1] - stamps[0]), "world markers at 20 Hz")
+        self.assertLess(max(b - a for a, b in zip(stamps, stamps[1:])), 0.5, "a gap in the world's markers")
+        compared = 0
+        for array in arrays:
+            spaces = {}
+            for m in array.markers:
+                spaces.setdefault(m.ns, []).append(m)
+            self.assertEqual(sorted(m.id for m in spaces["bodies"]), list(range(6)))
+            self.assertEqual(sorted(m.id for m in spaces["headings"]), list(range(6)))
+            # The hexagon's robots never touch: the contact markers stay deleted.
+            self.assertEqual({m.action for m in spaces["touching"] + spaces["contacts"]}, {m.DELETE})
+            for arrow in spaces["headings"]:
+                pose = odom.get((arrow.id, arrow.header.stamp.to_nsec()))
+                if pose is None:  # the odometry of the same instant was not recorded
+                    continue
+                compared += 1
+                start, end = arrow.points
+                self.assertAlmostEqual(start.x, pose[0], places=9)
+                self.assertAlmostEqual(start.y, pose[1], places=9)
+                heading = np.arctan2(end.y - start.y, end.x - start.x)
+                self.assertAlmostEqual(float(np.angle(np.exp(1j * (heading - pose[2])))), 0.0, places=9)
+        self.assertGreater(compared, 0.9 * 6 * len(arrays), "heading arrows compared with the odometry")
+
+
 if __name__ == "__main__":
-    rostest.rosrun(PKG, "render_test", RenderRobotsTest if "robots" in sys.argv[1:] else RenderTest, sys.argv)
+    kind = {"robots": RenderRobotsTest, "mujoco": RenderMujocoTest}
+    chosen = next((kind[a] for a in sys.argv[1:] if a in kind), RenderTest)
+    rostest.rosrun(PKG, "render_test", chosen, sys.argv)

@@ -116,6 +116,70 @@ TEST(MjcfModel, ObstaclesAreStaticGeomsNamedInOrder) {
             "obstacles[0].radius: must be finite and > 0 m, got 0");
 }
 
+// The scenario's obstacles (the safety filter's, core/safety.hpp) are the world's: a disc a
+// cylinder, a box a box of the same extent, a point a thin post, numbered as the scenario lists them.
+TEST(MjcfModel, TheScenariosObstaclesBecomeStaticGeoms) {
+  const Scenario s = parseScenario(R"(
+name: obstacles
+dimension: 2
+kappa: 2
+time_step: 0.02
+steps: 10
+agents:
+  - {id: 0, initial_position: [0, 0], desired_position: [0, 0]}
+  - {id: 1, initial_position: [1, 0], desired_position: [1, 0]}
+edges: [[0, 1]]
+safety: {radius: 0.25, sensing_radius: 1, gamma: 0.2}
+obstacles:
+  - {center: [2.0, -1.5], radius: 0.3}
+  - {min: [-3.0, 1.0], max: [-1.0, 1.5]}
+  - {center: [0.5, 2.0], radius: 0}
+)", "obstacles.yaml");
+  const std::vector<StaticObstacle> obstacles = worldObstacles(s);
+  ASSERT_EQ(obstacles.size(), 3u);
+  const WorldSettings settings = settingsOf(WorldKinematics::Unicycle);
+  withModel(buildWorldMjcf(settings, worldStartPoses(s, settings, 0), obstacles),
+            [&](const mjModel* m, const mjData* d) {
+              const int disc = mj_name2id(m, mjOBJ_GEOM, "obstacle_0");
+              const int box = mj_name2id(m, mjOBJ_GEOM, "obstacle_1");
+              const int post = mj_name2id(m, mjOBJ_GEOM, "obstacle_2");
+              ASSERT_GE(disc, 0);
+              ASSERT_GE(box, 0);
+              ASSERT_GE(post, 0);
+              EXPECT_LT(mj_name2id(m, mjOBJ_GEOM, "obstacle_3"), 0);
+              for (int g : {disc, box, post}) {
+                EXPECT_EQ(m->geom_bodyid[g], 0) << g;  // the world body: static
+                // Standing on the floor, 0.3 m high: taller than the robots' bodies.
+                EXPECT_NEAR(d->geom_xpos[3 * g + 2], 0.15, 1e-12);
+                // As stiff as the robots' bodies (not MuJoCo's default time constant of 0.02 s).
+                EXPECT_EQ(m->geom_solref[2 * g], 0.005);
+              }
+              EXPECT_EQ(m->geom_type[disc], mjGEOM_CYLINDER);
+              EXPECT_NEAR(d->geom_xpos[3 * disc], 2.0, 1e-12);
+              EXPECT_NEAR(d->geom_xpos[3 * disc + 1], -1.5, 1e-12);
+              EXPECT_NEAR(m->geom_size[3 * disc], 0.3, 1e-12);
+              EXPECT_EQ(m->geom_type[box], mjGEOM_BOX);
+              EXPECT_NEAR(d->geom_xpos[3 * box], -2.0, 1e-12);
+              EXPECT_NEAR(d->geom_xpos[3 * box + 1], 1.25, 1e-12);
+              EXPECT_NEAR(m->geom_size[3 * box], 1.0, 1e-12);
+              EXPECT_NEAR(m->geom_size[3 * box + 1], 0.25, 1e-12);
+              EXPECT_EQ(m->geom_type[post], mjGEOM_CYLINDER);
+              EXPECT_NEAR(m->geom_size[3 * post], kMinObstacleHalfWidth, 1e-15);
+            });
+  // The world counts contacts with them as obstacle_0, obstacle_1, ... after the robots.
+  const MujocoWorld world(buildWorldMjcf(settings, worldStartPoses(s, settings, 0), obstacles), "obstacles", 2,
+                          settings);
+  ASSERT_EQ(world.obstacleGeoms().size(), 3u);
+  EXPECT_EQ(world.obstacleGeoms()[1].type, ObstacleGeom::Type::Box);
+  EXPECT_NEAR(world.obstacleGeoms()[1].size[1], 0.25, 1e-12);
+  StaticObstacle flat;
+  flat.shape = StaticObstacle::Shape::Box;
+  flat.halfX = 1.0;
+  EXPECT_EQ(errorOf([&] { buildWorldMjcf(settings, {PlanarPose{}}, {flat}); }),
+            "obstacles[0].half_y: must be finite and > 0 m, got 0");
+  EXPECT_TRUE(worldObstacles(hexagon()).empty());
+}
+
 TEST(MjcfModel, ThreeDimensionalScenariosAreRefused) {
   const Scenario s = loadScenario(std::string(VF_SOURCE_DIR) + "/config/tetrahedron.yaml");
   EXPECT_EQ(errorOf([&] { worldStartPoses(s, WorldSettings{}, 0); }),

@@ -165,6 +165,62 @@ TEST_P(HeadOnTest, RegistersTheContactAndDoesNotInterpenetrate) {
 
 INSTANTIATE_TEST_SUITE_P(Kinds, HeadOnTest, ::testing::Values(WorldKinematics::Unicycle, WorldKinematics::Holonomic));
 
+// A robot driven into each kind of the scenario's obstacles (a disc, then a box) registers one
+// contact with it and stops at its surface: no more than 1 cm inside it.
+class ObstacleContactTest : public ::testing::TestWithParam<WorldKinematics> {};
+
+TEST_P(ObstacleContactTest, RegistersTheContactAndDoesNotInterpenetrate) {
+  const WorldSettings s = settingsOf(GetParam());
+  const bool unicycle = GetParam() == WorldKinematics::Unicycle;
+  StaticObstacle disc;  // centre 1 m ahead on x
+  disc.x = 1.0;
+  disc.radius = 0.2;
+  StaticObstacle box;  // a wall 1 m ahead on y, from x = -1 to 1
+  box.shape = StaticObstacle::Shape::Box;
+  box.y = 1.1;
+  box.halfX = 1.0;
+  box.halfY = 0.1;
+  for (int k : {0, 1}) {
+    const bool towardsBox = k == 1;
+    const double heading = towardsBox ? 0.5 * kPi : 0.0;
+    // The obstacle in the model is obstacle_k: the disc alone first, then the box after a far-off disc.
+    std::vector<StaticObstacle> obstacles = {disc, box};
+    if (towardsBox) obstacles[0].x = 10.0;
+    else obstacles.pop_back();
+    MujocoWorld world(buildWorldMjcf(s, {{0.0, 0.0, unicycle ? heading : 0.0}}, obstacles), "test", 1, s);
+    double deepest = 0.0;  // how far the body's edge went past the obstacle's surface [m]
+    while (world.time() < 4.0) {
+      if (unicycle) world.setCommand(0, 0.5, 0.0, 0.0);
+      else world.setCommand(0, towardsBox ? 0.0 : 0.5, towardsBox ? 0.5 : 0.0, 0.0);
+      world.step();
+      const BodyOutline b = world.bodyOutline(0);
+      const double gap = towardsBox ? (box.y - box.halfY) - (b.y + b.radius)
+                                    : std::hypot(b.x - disc.x, b.y) - disc.radius - b.radius;
+      deepest = std::max(deepest, -gap);
+    }
+    const ContactLog& log = world.contacts();
+    std::printf("%s into the %s: %ld contacts, %s; deepest %.2f mm (MuJoCo), %.2f mm (body), force up to %.1f N\n",
+                kinematicsName(GetParam()).c_str(), towardsBox ? "box" : "disc", log.count(),
+                log.resultLines().c_str(), 1000 * log.maxPenetration(), 1000 * deepest, log.maxNormalForce());
+    EXPECT_EQ(log.count(), 1) << k;
+    ASSERT_TRUE(log.first().has_value());
+    EXPECT_EQ(log.first()->first, "robot_0");
+    EXPECT_EQ(log.first()->second, "obstacle_" + std::to_string(k));
+    EXPECT_GT(log.maxNormalForce(), 0.0);
+    EXPECT_LE(log.maxPenetration(), 0.01);
+    EXPECT_LE(deepest, 0.01);
+    EXPECT_EQ(log.active(), 1u);  // still pushing at the end
+    // Where they touch: on the obstacle's surface, in front of the robot.
+    ASSERT_EQ(world.touches().size(), 1u);
+    const Touch& t = world.touches().front();
+    if (towardsBox) EXPECT_NEAR(t.y, box.y - box.halfY, 0.01);
+    else EXPECT_NEAR(std::hypot(t.x - disc.x, t.y), disc.radius, 0.01);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Kinds, ObstacleContactTest,
+                         ::testing::Values(WorldKinematics::Unicycle, WorldKinematics::Holonomic));
+
 // Wheel odometry knows only the wheel angles: on a curving drive it leaves the true pose, more
 // the further the robot goes. Ground truth is the body's pose: integrating its own velocity
 // gives it back (to the integration error), however far it goes.

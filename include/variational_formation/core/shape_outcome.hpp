@@ -25,10 +25,6 @@ struct ShapeFindings {
 ShapeFindings findShape(const Formation& formation, const Positions& q, const Velocities& v, double scale,
                         bool congruent, double tolerance, double maxSpeed, bool withShapeError = true);
 
-/// The outcome of a run that the safety filter blocked: not converged, with line
-/// "not converged (blocked: agents 2, 4)"; the findings are kept.
-ShapeOutcome blockedShapeOutcome(ShapeOutcome outcome, const std::string& blocked);
-
 /**
  * Whether a run measures the O(n^2) shape error at `step`: at most a 200-agent cost per step on
  * average, so every step up to 200 agents, every ceil((n/200)^2) steps beyond, and always at the
@@ -52,6 +48,10 @@ struct ShapeOutcome {
   /// "not converged (final max distance error E m)".
   std::string line;
 };
+
+/// The outcome of a run that the safety filter blocked: not converged, with line
+/// "not converged (blocked: agents 2, 4)"; the findings are kept.
+ShapeOutcome blockedShapeOutcome(ShapeOutcome outcome, const std::string& blocked);
 
 /**
  * The verdict at the last step: the desired shape if congruent and not mirrored (or mirrored

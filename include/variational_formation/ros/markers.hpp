@@ -17,6 +17,9 @@ namespace vf {
 using variational_formation::AgentState;
 using variational_formation::FormationStatus;
 
+/// An rviz colour from its red, green, blue and opacity in [0, 1].
+std_msgs::ColorRGBA rgba(double r, double g, double b, double a);
+
 /// Colour of agent i in rviz (a fixed palette, so screenshots can be checked).
 std_msgs::ColorRGBA agentColour(int agent);
 

@@ -20,8 +20,10 @@ namespace vf {
  * `robot_<i>` below the node's namespace: it subscribes to `robot_<i>/cmd_vel` and publishes
  * `robot_<i>/odom`, `robot_<i>/joint_states` and tf world_frame -> <prefix>robot_<i>/base_link.
  * Contacts go to `~contacts` (WorldContact), the diagnostics and, once the monitor's run is over,
- * the result file. Time: paced to wall time by ~real_time_factor, or with ~clock the world
- * publishes /clock (as fast as it can with ~real_time_factor 0). Parameters: doc/ros_api.md.
+ * the result file. `~markers` (MarkerArray, ~marker_rate) draws the bodies, headings, obstacles
+ * and contacts (world_markers.hpp). Time: paced to wall time by ~real_time_factor, or with
+ * ~clock the world publishes /clock (as fast as it can with ~real_time_factor 0). The scenario's
+ * `obstacles:` are static geoms of the built world. Parameters: doc/ros_api.md.
  */
 class MujocoWorldNode {
  public:
@@ -50,12 +52,13 @@ class MujocoWorldNode {
   std::vector<RobotIo> robots_;
   bool wheelOdometry_ = false, clock_ = false;
   double publishPeriod_ = 0.01, cmdTimeout_ = 0.5, realTimeFactor_ = 1.0;
+  double markerPeriod_ = 0.05, nextMarkers_ = 0.0;  // simulated time [s]; period <= 0: no markers
   std::string worldFrame_, resultFile_;
   bool resultWritten_ = false, runOver_ = false;
   long saturated_ = 0, malformed_ = 0;
   double achievedFactor_ = 0.0;
   ros::NodeHandle nh_;
-  ros::Publisher contactPub_, clockPub_;
+  ros::Publisher contactPub_, clockPub_, markerPub_;
   ros::Subscriber progressSub_;
   tf2_ros::TransformBroadcaster tf_;
   diagnostic_updater::Updater diagnostics_;

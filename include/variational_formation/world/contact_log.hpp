@@ -13,6 +13,7 @@ struct Touch {
   int a = 0, b = 0;            ///< participant ids, a < b
   double normalForce = 0.0;    ///< summed normal force of the pair's contact points [N]
   double penetration = 0.0;    ///< deepest interpenetration of the pair [m] (>= 0)
+  double x = 0.0, y = 0.0;     ///< where they touch on the floor [m]: the mean of the contact points
 };
 
 /// A contact: a pair that touches at a step and had not touched for kSeparation before.
@@ -20,6 +21,7 @@ struct ContactEvent {
   double time = 0.0;           ///< simulated time of the first touching step [s]
   std::string first, second;   ///< the participants' names ("robot_1", "obstacle_0")
   double normalForce = 0.0;    ///< at that step [N]
+  double x = 0.0, y = 0.0;     ///< where they touched [m], world frame
 };
 
 /**
@@ -43,6 +45,8 @@ class ContactLog {
   std::size_t active() const { return active_; }
   double maxPenetration() const { return maxPenetration_; }
   double maxNormalForce() const { return maxNormalForce_; }
+  /// Every contact so far, in order (the markers show where each was).
+  const std::vector<ContactEvent>& events() const { return events_; }
   /// The result file's lines: "contacts: N" and "first_contact: ..." (a quoted line, or ~).
   std::string resultLines() const;
 
@@ -52,6 +56,7 @@ class ContactLog {
   std::size_t active_ = 0;
   long count_ = 0;
   std::optional<ContactEvent> first_;
+  std::vector<ContactEvent> events_;
   double maxPenetration_ = 0.0, maxNormalForce_ = 0.0;
 };
 

@@ -11,16 +11,29 @@
 namespace vf {
 
 /**
- * A static obstacle of the world: a vertical cylinder standing on the floor, geom
- * `obstacle_<k>`. This is the seam for the scenario's `obstacles:` block (the collision-avoidance
- * issue): once the core loader reads it, its shapes become these, and the world counts contacts
- * with them as robot-obstacle contacts.
+ * A static obstacle of the world, standing on the floor: geom `obstacle_<k>`, a vertical
+ * cylinder or a box with its sides along the world's axes. The world counts contacts with it as
+ * robot-obstacle contacts. worldObstacles makes them from the scenario's `obstacles:` block.
  */
 struct StaticObstacle {
+  enum class Shape { Cylinder, Box };
   double x = 0.0, y = 0.0;  ///< centre on the floor [m], world frame
-  double radius = 0.1;      ///< [m] > 0
+  double radius = 0.1;      ///< cylinder [m] > 0
   double height = 0.3;      ///< [m] > 0
+  Shape shape = Shape::Cylinder;
+  double halfX = 0.0, halfY = 0.0;  ///< box: half its extent along the world's x and y [m] > 0
 };
+
+/**
+ * The scenario's `obstacles:` as static geoms of its height [m] (doc/robots.md, "Obstacles"): a
+ * disc becomes a cylinder, an axis-aligned box a box. Both are what the safety filter keeps its
+ * agents from; a disc of radius 0 or a box that is flat along an axis (a point or a wall line to
+ * the filter) becomes a post or a wall kMinObstacleHalfWidth thick on each side.
+ * @throws InvalidInput "dimension: ..." for a scenario that is not planar.
+ */
+std::vector<StaticObstacle> worldObstacles(const Scenario& scenario, double height = 0.3);
+/// The half width [m] a point or a flat box of the scenario gets in the world (MuJoCo's geoms need one).
+constexpr double kMinObstacleHalfWidth = 0.005;
 
 /**
  * The start pose of robot i [m, m, rad], as robot_sim starts it: a holonomic base at the

@@ -26,6 +26,21 @@ struct JointReadings {
   std::vector<double> position, velocity, effort;  ///< [rad or m], [rad/s or m/s], [N m or N]
 };
 
+/// A robot's body as seen from above, for markers [m]: a vertical cylinder, world frame.
+struct BodyOutline {
+  double x = 0.0, y = 0.0, z = 0.0;  ///< centre
+  double radius = 0.0, halfHeight = 0.0;
+};
+
+/// A geom `obstacle_<k>` as the model has it, for markers: MuJoCo's type, pose and size [m].
+struct ObstacleGeom {
+  enum class Type { Cylinder, Box, Sphere, Other };
+  Type type = Type::Other;
+  double position[3] = {0.0, 0.0, 0.0};
+  double quaternion[4] = {1.0, 0.0, 0.0, 0.0};  ///< w, x, y, z
+  double size[3] = {0.0, 0.0, 0.0};              ///< MuJoCo's: radius and half height, or half sides
+};
+
 /**
  * N robots in a MuJoCo world (ROS-free; doc/robots.md, "The MuJoCo world"). Each robot is a
  * body `robot_<i>` whose motion MujocoWorld drives through named joints and velocity actuators:
@@ -79,7 +94,15 @@ class MujocoWorld {
   /// The forces [N] or torques [N m] of the robot's actuators at the last step.
   std::vector<double> actuatorForces(int robot) const;
 
+  /// The cylinder geom `robot_<i>_body` (the built model's body), else a cylinder of the settings'
+  /// body_radius about the body's origin.
+  BodyOutline bodyOutline(int robot) const;
+  /// The model's obstacles, in the order of their contact ids (obstacle_<k> is the k-th).
+  std::vector<ObstacleGeom> obstacleGeoms() const;
+
   const ContactLog& contacts() const { return contacts_; }
+  /// The pairs touching at the last step, with where they touch.
+  const std::vector<Touch>& touches() const { return touches_; }
   /// The contacts that began at the last step.
   const std::vector<ContactEvent>& newContacts() const { return newContacts_; }
 
@@ -105,6 +128,8 @@ class MujocoWorld {
   std::vector<int> obstacleOfGeom_;     // geom id -> obstacle index, else -1
   ContactLog contacts_;
   std::vector<ContactEvent> newContacts_;
+  std::vector<Touch> touches_;
+  std::vector<int> bodyGeoms_;          // robot -> its geom robot_<i>_body, else -1
   int unstableSeen_ = 0;
   mutable bool stale_ = true;           // the body positions lag qpos until refresh()
 };

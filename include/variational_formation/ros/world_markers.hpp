@@ -1,0 +1,24 @@
+#pragma once
+
+#include <std_msgs/Header.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include "variational_formation/world/mujoco_world.hpp"
+
+namespace vf {
+
+/// At most this many past contacts are drawn (the newest ones).
+constexpr std::size_t kDrawnContacts = 200;
+
+/**
+ * rviz markers of a MuJoCo world (doc/robots.md, "Markers"), in the header's frame and stamp:
+ * - `bodies`: each robot's body as a cylinder in its agent's colour (agentColour), half opaque;
+ * - `headings`: an arrow per robot from its origin (a unicycle's axle) along its heading, two body
+ *   radii long;
+ * - `obstacles`: the model's obstacle geoms, grey;
+ * - `touching`: a red sphere where two participants touch now (deleted while none do);
+ * - `contacts`: a small orange sphere where each contact so far began (the newest kDrawnContacts).
+ */
+visualization_msgs::MarkerArray makeWorldMarkers(const MujocoWorld& world, const std_msgs::Header& header);
+
+}  // namespace vf
