@@ -107,13 +107,15 @@ SteeringStep GoalSteering::update(long step, const FormationPose& pose, bool inS
   previousStep_ = step;
   const double slowSpeed = settings_.gain * settings_.positionTolerance;
   const double slowTurn = settings_.gain * settings_.yawTolerance;
-  if (s.distance <= settings_.positionTolerance && std::abs(s.yawError) <= settings_.yawTolerance &&
-      rate(0) <= slowSpeed && rate(1) <= slowTurn && lastVelocity_.norm() <= 2.0 * slowSpeed &&
+  const bool within = s.distance <= settings_.positionTolerance && std::abs(s.yawError) <= settings_.yawTolerance;
+  if (within && rate(0) <= slowSpeed && rate(1) <= slowTurn && lastVelocity_.norm() <= 2.0 * slowSpeed &&
       lastAngularRate_.norm() <= 2.0 * slowTurn) {
     return finish(s, SteeringStep::State::Succeeded);
   }
-  // Progress: either error down by half its tolerance since the last progress.
-  bool progressed = false;
+  // Progress: either error down by half its tolerance since the last progress, or within both
+  // tolerances and settling there (in lockstep a command applies up to a window later, so the
+  // formation can sit within tolerance, still moving, for longer than the patience).
+  bool progressed = within;
   if (s.distance <= bestDistance_ - 0.5 * settings_.positionTolerance) {
     bestDistance_ = s.distance;
     progressed = true;

@@ -174,6 +174,19 @@ TEST(GoalSteering, AbortsAfterPatienceWithoutProgressSayingWhy) {
   far.position << 100.0, 0.0;
   steer.start(far, 0);
   for (long k = 0; k < 2000; ++k) ASSERT_EQ(steer.update(k, at(0.001 * k, 0, 0), true, 0.0).state, SteeringStep::State::Active);
+  // Within both tolerances but still moving (a lockstep command applies up to a window later):
+  // settling there is not "no progress", for any length of time. Found by goal.test, where the
+  // formation circled 2 cm from the goal at 0.03 m/s and was aborted.
+  GoalSteering settling(g, 0.01);
+  GoalPose near;
+  near.position << 2.0, 0.0;
+  settling.start(near, 0);
+  for (long k = 0; k < 1000; ++k) {
+    const double a = 0.03 * static_cast<double>(k) * 0.01 / 0.02;  // 0.03 m/s on a 2 cm circle
+    ASSERT_EQ(settling.update(k, at(2.0 + 0.02 * std::cos(a), 0.02 * std::sin(a), 0.0), true, 0.0).state,
+              SteeringStep::State::Active)
+        << k;
+  }
 }
 
 // The closed loop, as the monitor runs it: each completed step measured, each command offered to

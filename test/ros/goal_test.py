@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """rostest (goal.test): goals for a recorded lockstep formation, sent as a user would.
 
-In one run of goal_hexagon (hexagon_steer, side 2, for 35 s of simulated time at rate 5):
+In one run of goal_hexagon (hexagon_steer, side 2, for 45 s of simulated time at rate 5):
 1. an action goal on formation/move_to (move_base_msgs/MoveBase) succeeds, with feedback, and
    the centroid (computed here from the agents' own states) and the heading (a 2D Kabsch fit of
    the desired shape, computed here) end within the tolerances (5 cm, 0.05 rad) plus what the
