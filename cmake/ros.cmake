@@ -1,5 +1,5 @@
 # The ROS layer: thin nodes over the core, plus rostests.
-add_library(variational_formation_ros src/ros/agent_commands.cpp src/ros/agent_node.cpp src/ros/markers.cpp
+add_library(variational_formation_ros src/ros/agent_commands.cpp src/ros/agent_node.cpp src/ros/agent_recovery.cpp src/ros/markers.cpp
   src/ros/monitor_node.cpp
   src/ros/output_files.cpp
   src/ros/participants.cpp

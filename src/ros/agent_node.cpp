@@ -240,54 +240,6 @@ void AgentNode::reportWaiting() {
   lastReportAt_ = ros::WallTime::now();
 }
 
-AgentNode::Recovery AgentNode::askHolders() const {
-  // With an own board every agent holds our newest state: one that used our last step may be
-  // ahead of the neighbours and the monitor (doc/distributed.md, "Sensing").
-  return recallNewest(nh_, agent_->id(), sources(), monitor_);
-}
-
-void AgentNode::resume(const Recovery& r) {
-  const long best = r.step;
-  const RecallState::Response& found = r.found;
-  const std::string& from = r.from;
-  if (best <= 0) {
-    ROS_INFO("%s: nobody holds a state of mine beyond step 0: starting from the scenario", name_.c_str());
-    return;
-  }
-  try {
-    agent_->resume(best, found.position, found.previous_position);
-    ROS_INFO("%s: recovered step %ld from %s; resuming", name_.c_str(), best, from.c_str());
-  } catch (const std::exception& e) {
-    ROS_WARN("%s: cannot resume from %s (%s): starting from the scenario", name_.c_str(), from.c_str(), e.what());
-  }
-}
-
-bool AgentNode::onRecall(RecallState::Request& request, RecallState::Response& response) {
-  long step = -1;
-  response.held = agent_->neighbourState(static_cast<int>(request.id), step, response.position,
-                                         response.previous_position);
-  response.step = step;
-  return true;
-}
-
-bool AgentNode::onHistory(RecallHistory::Request& request, RecallHistory::Response& response) {
-  // Its own states, or those it holds of the neighbour request.id.
-  const std::vector<int>& ids = agent_->neighbourIds();
-  const auto k = std::find(ids.begin(), ids.end(), static_cast<int>(request.id)) - ids.begin();
-  const std::deque<AgentState::ConstPtr>* held = nullptr;
-  if (request.id == agent_->id()) {
-    held = &history_;
-  } else if (k < static_cast<long>(ids.size())) {
-    held = &neighbourHistory_[static_cast<std::size_t>(k)];
-  }
-  if (held) {
-    for (const AgentState::ConstPtr& state : *held) response.states.push_back(*state);
-  }
-  response.progress = lastProgress_;
-  response.has_progress = hasProgress_;
-  return true;
-}
-
 void AgentNode::start(const Recovery& recovery) {
   resume(recovery);
   subscribeToFormation(
