@@ -294,6 +294,21 @@ def palette(k):
     return colours[k % len(colours)]
 
 
+def group_runs(group):
+    """Whether a process of process group `group`, other than a zombie, is alive."""
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if len(fields) > 2 and int(fields[2]) == group and fields[0] not in ("Z", "X"):
+            return True
+    return False
+
+
 class Processes:
     """The processes of one render, each the leader of its own process group, so that stopping it
     stops its children too (rosbag play's player, ...)."""
@@ -340,11 +355,18 @@ class Processes:
                 break
             except subprocess.TimeoutExpired:
                 continue
-        # The leader may be gone while others of its group are not.
-        try:
-            os.killpg(p.pid, signal.SIGKILL)
-        except ProcessLookupError:
-            pass
+        # The leader may be gone while others of its group are not. SIGKILL is delivered
+        # asynchronously: wait until no process of the group runs any more, so that none
+        # outlives the render (a zombie left to init to reap does not run).
+        deadline = time.monotonic() + 5.0
+        while True:
+            try:
+                os.killpg(p.pid, signal.SIGKILL)
+            except ProcessLookupError:
+                break
+            if not group_runs(p.pid) or time.monotonic() > deadline:
+                break
+            time.sleep(0.02)
 
     def stop_all(self):
         while self.running:

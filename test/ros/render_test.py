@@ -68,10 +68,13 @@ def test_display(offset=0):
 
 
 def proc_stat(pid):
-    """(parent pid, process group, start time) of a live process, or None."""
+    """(parent pid, process group, start time) of a live process, or None (also for a zombie,
+    which no longer runs and waits for init to reap it)."""
     try:
         with open(f"/proc/{pid}/stat") as f:
             fields = f.read().rsplit(")", 1)[1].split()
+        if fields[0] in ("Z", "X"):
+            return None
         return int(fields[1]), int(fields[2]), int(fields[19])
     except (OSError, IndexError, ValueError):
         return None
