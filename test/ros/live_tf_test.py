@@ -35,6 +35,10 @@ class LiveTf(unittest.TestCase):
         while rospy.Time.now().is_zero() and time.time() < end:
             time.sleep(0.05)
         self.assertFalse(rospy.Time.now().is_zero(), "no /clock from the monitor within 60 s")
+        # A listener holds only what arrived after it connected to the broadcasters, which may be
+        # after /clock: a consumer that joins a run looks up times from its first transform on.
+        while not buffer.can_transform("world", "formation/agent_0", rospy.Time(0)) and time.time() < end:
+            time.sleep(0.05)
         found, failures = [], []
         while len(found) < LOOKUPS and time.time() < end:
             now = rospy.Time.now()
