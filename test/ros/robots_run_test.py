@@ -6,7 +6,7 @@ agents' states.
 - The run succeeds and the monitor says the formation converged.
 - The monitor measured the robots from their odometry (robot mode): the result file carries the
   robots' figures, the run converged at the later of the agents' and the robots' steps, the
-  robots' max distance error at the end is within the tolerance, and it agrees (2 mm) with this
+  robots' max distance error at the end is within the tolerance, and it agrees (3 mm) with this
   test's own average of the recorded odometry; every status from the robots' step on says in shape.
 - The robots' points (a unicycle's hand point, hand_offset ahead of the axle at the odometry
   heading), averaged over the run's last second, are congruent with the desired shape: every
@@ -241,8 +241,8 @@ class RobotsRun(unittest.TestCase):
                     for a in range(self.n()) for b in range(a + 1, self.n()))
         print(f"test: the robots' max distance error from the bag's odometry {own:.4f} m (monitor "
               f"{r['robots_max_distance_error']:.4f} m); worst pair {slack * 1000:+.2f} mm beyond 1%", flush=True)
-        self.assertLess(abs(own - r["robots_max_distance_error"]), 0.002)
-        self.assertLess(slack, 0.002)
+        self.assertLess(abs(own - r["robots_max_distance_error"]), 0.003)
+        self.assertLess(slack, 0.003)
 
     def test_robots_form_the_shape(self):
         self.assertTrue(self.status, "no status in the bag")
