@@ -6,7 +6,8 @@ target_sources(variational_formation_core PRIVATE
   src/core/delay_margin.cpp
   src/core/delay_campaign.cpp
   src/core/robot_mode.cpp
-  src/core/robot_link.cpp)
+  src/core/robot_link.cpp
+  src/core/robot_shape_watch.cpp)
 target_sources(variational_formation_tools PRIVATE
   src/tools/progress.cpp
   src/tools/delay_margin_cli.cpp)

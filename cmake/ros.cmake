@@ -10,7 +10,7 @@ target_sources(variational_formation_ros PRIVATE src/ros/timed_agent_node.cpp sr
 # The monitor's two modes over its shared wiring, and the bounded pool of service calls.
 target_sources(variational_formation_ros PRIVATE src/ros/lockstep_monitor.cpp src/ros/monitor_commands.cpp
   src/ros/monitor_parameters.cpp src/ros/timed_monitor.cpp src/ros/monitor_outputs.cpp
-  src/ros/monitor_shape.cpp src/ros/monitor_goals.cpp src/ros/goal_server.cpp src/ros/monitor_safety.cpp
+  src/ros/monitor_shape.cpp src/ros/monitor_robots.cpp src/ros/monitor_goals.cpp src/ros/goal_server.cpp src/ros/monitor_safety.cpp
   src/ros/recorder_bag.cpp src/ros/recorder_commands.cpp
   src/ros/sensing_hub.cpp src/ros/service_call.cpp src/ros/state_batch.cpp src/ros/periodic_call.cpp)
 add_dependencies(variational_formation_ros ${PROJECT_NAME}_gencfg)

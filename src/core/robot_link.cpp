@@ -50,20 +50,29 @@ RobotLink::RobotLink(const RobotLinkSettings& settings, int dimension, double ti
   point_.assign(static_cast<std::size_t>(dimension), 0.0);
 }
 
-void RobotLink::measureOdometry(double x, double y, double z, double qx, double qy, double qz, double qw) {
+PlanarPose pointFromOdometry(RobotKinematics kinematics, double handOffset, int dimension, double x, double y,
+                             double z, double qx, double qy, double qz, double qw, double* point) {
   // poseFromOdometry checks every number and the quaternion, for either kinematics.
   const PlanarPose pose = poseFromOdometry(x, y, qx, qy, qz, qw);
-  if (dimension_ == 3 && !std::isfinite(z)) {
+  if (dimension == 3 && !std::isfinite(z)) {
     throw InvalidInput("odometry: position and orientation must be finite, got z " + formatNumber(z));
   }
-  if (settings_.kinematics == RobotKinematics::Unicycle) {
-    measurePose(pose);
+  if (kinematics == RobotKinematics::Unicycle) {
+    handPoint(pose, handOffset, point);
   } else {
-    point_[0] = x;
-    point_[1] = y;
-    if (dimension_ == 3) point_[2] = z;
-    measured_ = true;
+    point[0] = x;
+    point[1] = y;
+    if (dimension == 3) point[2] = z;
   }
+  return pose;
+}
+
+void RobotLink::measureOdometry(double x, double y, double z, double qx, double qy, double qz, double qw) {
+  const PlanarPose pose =
+      pointFromOdometry(settings_.kinematics, settings_.hand.handOffset, dimension_, x, y, z, qx, qy, qz, qw,
+                        point_.data());
+  if (settings_.kinematics == RobotKinematics::Unicycle) heading_ = pose.heading;
+  measured_ = true;
 }
 
 void RobotLink::measurePose(const PlanarPose& pose) {

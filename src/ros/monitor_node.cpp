@@ -80,6 +80,7 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh, bool timed) 
   setUpCommands(nh, pnh);
   setUpGoals(nh, pnh);
   setUpSafety(pnh, timed);
+  setUpRobots(nh, pnh, timed);
   setUpParameters(nh, timed);
 }
 

@@ -34,6 +34,7 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
   noteShape(s);
   status.min_separation = std::numeric_limits<double>::quiet_NaN();  // without a safety block (FormationStatus.msg)
   const bool blocked = watchSafety(s, status);
+  watchRobots(s, status);
   if (!noetherHolds) {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     status.linear_momentum_predicted.x = status.linear_momentum_predicted.y = status.linear_momentum_predicted.z = nan;
@@ -87,7 +88,7 @@ void MonitorNode::writeResult(const std::string& result, const std::string& reas
     << "\nshape_error: " << formation.findings.shapeError << "\nformation: \""
     << formation.line << "\"\nfinal_max_distance_error: " << finalError_ << "\ndropped: " << dropped_ << "\ncommands: " << commandsIssued()
     << "\ncommands_refused: " << commandsRefused_ << "\ncommands_saturated: " << desk_->saturated()
-    << "\nreason: \"" << quoted << "\"\n" << safetyResultLines();
+    << "\nreason: \"" << quoted << "\"\n" << safetyResultLines() << robotsResultLines();
   if (!f) ROS_ERROR("monitor: cannot write the result file %s", resultFile_.c_str());
 }
 

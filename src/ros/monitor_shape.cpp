@@ -13,7 +13,7 @@ void MonitorNode::noteShape(const FormationSnapshot& s) {
   lastScale_ = s.scale;
 }
 
-ShapeOutcome MonitorNode::shapeVerdict() const {
+ShapeOutcome MonitorNode::agentsVerdict() const {
   ShapeFindings f = lastShape_;
   // Beyond 200 agents the shape error skips steps (FormationSnapshot::shape): the verdict needs it.
   if (std::isnan(f.shapeError) && lastPositions_.size() > 0) {
@@ -22,6 +22,12 @@ ShapeOutcome MonitorNode::shapeVerdict() const {
   const ShapeOutcome o = shapeOutcome(f, convergedStep_, scenario_.mirrorAllowed, scenario_.timeStep);
   const std::string blocked = blockedBy();
   return blocked.empty() ? o : blockedShapeOutcome(o, blocked);
+}
+
+ShapeOutcome MonitorNode::shapeVerdict() const {
+  // Robot mode: converged means the robots are in shape too (doc/robots.md).
+  if (!robots_) return agentsVerdict();
+  return robotModeOutcome(agentsVerdict(), robots_->outcome(scenario_.timeStep), scenario_.timeStep);
 }
 
 }  // namespace vf

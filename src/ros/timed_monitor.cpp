@@ -80,6 +80,7 @@ void TimedMonitor::watch() {
     if (!checkAlive(agents_[static_cast<std::size_t>(i)], "agent_" + std::to_string(i), respawnTimeout_)) return;
   }
   if (!referee_->started()) reportWaiting("timed mode, waiting for " + waitingFor());
+  reportRobotsMissing();
 }
 
 std::string TimedMonitor::waitingFor() const {

@@ -7,22 +7,14 @@
 
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/robot_link.hpp"
+#include "test_support.hpp"
 
 namespace vf {
 namespace {
 
 constexpr double kPi = 3.141592653589793;
 
-// What `call` throws, or "" if it does not.
-template <class F>
-std::string thrown(F call) {
-  try {
-    call();
-  } catch (const InvalidInput& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::thrown;
 
 RobotLinkSettings unicycle(RobotFeedback feedback) {
   RobotLinkSettings s;

@@ -19,6 +19,17 @@ inline std::string configPath(const std::string& name) {
   return std::string(VF_SOURCE_DIR) + "/config/" + name + ".yaml";
 }
 
+/// What `call` throws as InvalidInput, or "" if it does not throw.
+template <class F>
+std::string thrown(F call) {
+  try {
+    call();
+  } catch (const InvalidInput& e) {
+    return e.what();
+  }
+  return "";
+}
+
 /// `text` with the first `from` replaced by `to` (a failure if there is none).
 inline std::string replaced(std::string text, const std::string& from, const std::string& to) {
   const auto at = text.find(from);

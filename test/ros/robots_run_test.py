@@ -4,6 +4,10 @@ robot mode form the shape, checked from the robots' own odometry in the recorded
 agents' states.
 
 - The run succeeds and the monitor says the formation converged.
+- The monitor measured the robots from their odometry (robot mode): the result file carries the
+  robots' figures, the run converged at the later of the agents' and the robots' steps, the
+  robots' max distance error at the end is within the tolerance, and it agrees (3 mm) with this
+  test's own average of the recorded odometry; every status from the robots' step on says in shape.
 - The robots' points (a unicycle's hand point, hand_offset ahead of the axle at the odometry
   heading), averaged over the run's last second, are congruent with the desired shape: every
   pair's distance within 1 cm of the desired one.
@@ -185,16 +189,60 @@ class RobotsRun(unittest.TestCase):
         theta = yaw(msg.pose.pose.orientation)
         return p.x + self.hand_offset * math.cos(theta), p.y + self.hand_offset * math.sin(theta)
 
-    def pair_error(self, t0, t1):
-        """Worst | |p_i - p_j| - |q*_i - q*_j| | [m] over all pairs, points averaged over [t0, t1)."""
+    def mean_points(self, t0, t1):
+        """Each robot's point averaged over its odometry recorded in [t0, t1)."""
         mean = []
         for i in range(self.n()):
             window = [self.point(m) for t, m in self.odom[f"/formation/robot_{i}/odom"] if t0 <= t < t1]
             self.assertTrue(window, f"robot_{i}: no odometry in [{t0:.1f}, {t1:.1f})")
             mean.append((sum(p[0] for p in window) / len(window), sum(p[1] for p in window) / len(window)))
-        desired = [a["desired_position"] for a in sorted(self.scenario["agents"], key=lambda a: a["id"])]
+        return mean
+
+    def desired(self):
+        return [a["desired_position"] for a in sorted(self.scenario["agents"], key=lambda a: a["id"])]
+
+    def pair_error(self, t0, t1):
+        """Worst | |p_i - p_j| - |q*_i - q*_j| | [m] over all pairs, points averaged over [t0, t1)."""
+        mean, desired = self.mean_points(t0, t1), self.desired()
         return max(abs(math.dist(mean[a], mean[b]) - math.dist(desired[a], desired[b]))
                    for a in range(self.n()) for b in range(a + 1, self.n()))
+
+    def test_verdict_is_the_robots_from_their_odometry(self):
+        # The monitor measured the robots (robots.launch sets ~measure_robots): the result file has
+        # their figures, the run converged at the later of the agents' and the robots' steps, and
+        # what it says of the robots at the end is what this test measures in the recorded odometry.
+        r = self.result
+        for key in ("robots_in_shape_step", "robots_max_distance_error", "robots_shape_error", "agents_converged_step",
+                    "odometry_dropped", "robots"):
+            self.assertIn(key, r)
+        robots, agents = int(r["robots_in_shape_step"]), int(r["agents_converged_step"])
+        print(f"monitor: agents converged at step {agents}, robots in shape from step {robots}, run converged at "
+              f"step {r['converged_step']}; robots at the end: max distance error {r['robots_max_distance_error']:.4f} m, "
+              f"shape error {r['robots_shape_error']:.4f} m ({r['robots']})", flush=True)
+        self.assertGreaterEqual(robots, 0, r)
+        self.assertEqual(int(r["converged_step"]), max(robots, agents), r)
+        self.assertEqual(r["odometry_dropped"], 0)
+        desired = self.desired()
+        # In shape: every pair within 1% of its desired distance, so every edge within 1% of the longest.
+        longest = max(math.dist(desired[a], desired[b]) for a, b in self.scenario["edges"])
+        self.assertLess(r["robots_max_distance_error"], 0.01 * longest, r)
+        # The statuses say the same: the last one carries the result's figures, and every status
+        # from the robots' step on has the robots in shape.
+        end, last = self.status[-1]
+        self.assertEqual(last.robots_in_shape_step, robots)
+        self.assertAlmostEqual(last.robots_max_distance_error, r["robots_max_distance_error"], delta=1e-5)
+        in_stretch = [s.robots_in_shape for _, s in self.status if s.step >= robots]
+        self.assertTrue(in_stretch and all(in_stretch), f"{in_stretch.count(False)} of {len(in_stretch)} not in shape")
+        # This test's own measurement: the recorded odometry over the monitor's window (0.5 s)
+        # before its last status. The two averages hold nearly the same samples.
+        mean = self.mean_points(end - 0.5, end)
+        own = max(abs(math.dist(mean[a], mean[b]) - math.dist(desired[a], desired[b])) for a, b in self.scenario["edges"])
+        slack = max(abs(math.dist(mean[a], mean[b]) - math.dist(desired[a], desired[b])) - 0.01 * math.dist(desired[a], desired[b])
+                    for a in range(self.n()) for b in range(a + 1, self.n()))
+        print(f"test: the robots' max distance error from the bag's odometry {own:.4f} m (monitor "
+              f"{r['robots_max_distance_error']:.4f} m); worst pair {slack * 1000:+.2f} mm beyond 1%", flush=True)
+        self.assertLess(abs(own - r["robots_max_distance_error"]), 0.003)
+        self.assertLess(slack, 0.003)
 
     def test_robots_form_the_shape(self):
         self.assertTrue(self.status, "no status in the bag")

@@ -3,7 +3,9 @@
 make_agents_launch.py with a bad timed or robot argument, each end with exit status 2 and one line
 on stderr naming the field and the value. Odometry that is not a pose (a NaN, a quaternion that is
 not a rotation), sent by this test's own node, is dropped, counted and warned about by a
-robot-mode agent, which stays up."""
+robot-mode agent, which stays up. A monitor measuring robots (~measure_robots) refuses bad settings
+in one line, and drops such odometry the same way, names the robots whose odometry it waits for,
+and stays up."""
 import contextlib
 import os
 import signal
@@ -143,6 +145,51 @@ class TimedBadInput(unittest.TestCase):
         self.assertTrue(any("no odometry on /odd_robot/odom" in m.msg for m in lines[-20:]),
                         [m.msg for m in lines])
         self.assertFalse(any("first odometry" in m.msg for m in lines), [m.msg for m in lines])
+
+    def monitor(self, name, **params):
+        base = {"scenario": HEXAGON, "mode": "timed", "real_time_factor": "1", "measure_robots": "true"}
+        base.update(params)
+        return run(["rosrun", vf_rostest.PKG, "monitor", f"__name:={name}", "__ns:=/bad"] +
+                   [f"_{k}:={v}" for k, v in base.items()])
+
+    def test_monitor_refuses_bad_robot_settings(self):
+        self.check(self.monitor("monitor_lockstep", mode="lockstep"), "measure_robots", "lockstep")
+        self.check(self.monitor("monitor_tank", kinematics="tank"), "kinematics", "tank")
+        self.check(self.monitor("monitor_hand", kinematics="unicycle", hand_offset="-0.1"), "hand_offset", "-0.1")
+        self.check(self.monitor("monitor_window", robots_window="0"), "robots_window", "0")
+
+    def test_monitor_drops_bad_odometry_and_names_the_robots_it_waits_for(self):
+        # A timed monitor measuring unicycles, without agents; robot_0's odometry is not a pose, the
+        # other robots never publish.
+        lines = []
+        sub = rospy.Subscriber("/rosout", Log, lambda m: lines.append(m.msg) if m.name == "/watch/monitor" else None,
+                               queue_size=1000)
+        pub = rospy.Publisher("/watch/robot_0/odom", Odometry, queue_size=10)
+        p = subprocess.Popen(["rosrun", vf_rostest.PKG, "monitor", "__name:=monitor", "__ns:=/watch",
+                              f"_scenario:={HEXAGON}", "_mode:=timed", "_real_time_factor:=1", "_measure_robots:=true",
+                              "_kinematics:=unicycle"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        try:
+            end = time.time() + 20
+            while pub.get_num_connections() == 0 and time.time() < end:
+                time.sleep(0.1)
+            self.assertEqual(pub.get_num_connections(), 1, "the monitor never subscribed to /watch/robot_0/odom")
+            nan = Odometry()
+            nan.pose.pose.position.x = float("nan")
+            nan.pose.pose.orientation.w = 1.0
+            pub.publish(nan)
+            time.sleep(6.0)  # the line about missing robots comes 5 s after the start
+            self.assertIsNone(p.poll(), "the monitor ended on bad odometry")
+        finally:
+            p.send_signal(signal.SIGINT)
+            p.wait(timeout=20)
+            sub.unregister()
+        dropped = [m for m in lines if "dropped an odometry message on /watch/robot_0/odom" in m]
+        self.assertEqual(len(dropped), 1, lines)
+        self.assertIn("robot_0: odometry:", dropped[0])
+        self.assertIn("1 dropped so far", dropped[0])
+        waiting = [m for m in lines if "waiting for the robots' odometry" in m]
+        self.assertTrue(waiting, lines)
+        self.assertIn("no odometry yet on " + ", ".join(f"/watch/robot_{i}/odom" for i in range(6)), waiting[0])
 
     def test_missing_odometry_holds_and_says_so(self):
         # A robot-mode agent whose odom topic has no publisher: it stays up, holds, and says so

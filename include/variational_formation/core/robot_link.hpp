@@ -26,6 +26,18 @@ const char* kinematicsName(RobotKinematics kinematics);
 const char* feedbackName(RobotFeedback feedback);
 
 /**
+ * The point of a robot that the formation controls, from an odometry pose: position (x, y, z)
+ * [m], orientation quaternion (qx, qy, qz, qw). Holonomic: the position (z only in 3D); unicycle:
+ * the hand point handOffset [m] ahead of the axle at the quaternion's yaw (hand_point.hpp).
+ * Writes `dimension` values to `point` only once every number passed its check.
+ * @return the planar pose (its heading is a unicycle's).
+ * @throws InvalidInput "odometry: ..." on a non-finite value or a quaternion whose norm is not 1
+ * (within kQuaternionNormTolerance).
+ */
+PlanarPose pointFromOdometry(RobotKinematics kinematics, double handOffset, int dimension, double x, double y,
+                             double z, double qx, double qy, double qz, double qw, double* point);
+
+/**
  * The agent's side of robot mode, without a transport: what the agent makes of its robot's
  * odometry and what it sends back. One per robot-mode agent (TimedAgentNode); runRobotLoop runs
  * the same class against simulated robots.

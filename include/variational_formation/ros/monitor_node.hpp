@@ -8,6 +8,7 @@
 
 #include <dynamic_reconfigure/server.h>
 #include <geometry_msgs/Twist.h>
+#include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <std_msgs/Float64.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -19,6 +20,7 @@
 #include "variational_formation/RecallState.h"
 #include "variational_formation/RunProgress.h"
 #include "variational_formation/core/monitor.hpp"
+#include "variational_formation/core/robot_shape_watch.hpp"
 #include "variational_formation/core/run_outcome.hpp"
 #include "variational_formation/core/safety_watch.hpp"
 #include "variational_formation/core/protocol/command_desk.hpp"
@@ -181,7 +183,24 @@ class MonitorNode {
   // The run's shape (src/ros/monitor_shape.cpp): the newest step's findings and the verdict
   // that `simulate` gives too (shapeOutcome), for the result file and the last line.
   void noteShape(const FormationSnapshot& s);
+  /// The agents' verdict; with ~measure_robots the run's is the worse or later of it and the
+  /// robots' (robotModeOutcome).
+  ShapeOutcome agentsVerdict() const;
   ShapeOutcome shapeVerdict() const;
+
+  // The robots of a robot-mode run (src/ros/monitor_robots.cpp, doc/robots.md "Converged means
+  // the robots"), with ~measure_robots: robot_<i>/odom, averaged (core RobotShapeWatch), the
+  // robots' errors in every status, their verdict in the result file and the last line.
+  /// ~measure_robots, ~kinematics, ~hand_offset, ~robots_window; subscribes to the odometry.
+  void setUpRobots(ros::NodeHandle& nh, ros::NodeHandle& pnh, bool timed);
+  void onOdometry(int id, const nav_msgs::Odometry& msg);
+  /// Measures the robots at the step of `s` and fills the status's robots_ fields.
+  void watchRobots(const FormationSnapshot& s, FormationStatus& status);
+  /// A WARN line (every 5 s at most) naming the robots whose odometry has not come or stopped.
+  void reportRobotsMissing();
+  /// The result file's robots_ lines (empty without ~measure_robots).
+  std::string robotsResultLines() const;
+  std::unique_ptr<RobotShapeWatch> robots_;
 
  private:
   void writeResult(const std::string& result, const std::string& reason) const;
@@ -205,6 +224,10 @@ class MonitorNode {
   double lastScale_ = 1.0;
   int exitStatus_ = -1;
   std::unique_ptr<SafetyWatch> safety_;  // a scenario with `safety:` only
+  std::vector<ros::Subscriber> odomSubs_;  // ~measure_robots: robot_<i>/odom
+  long badOdometry_ = 0;                   // odometry messages refused (not finite, not a rotation)
+  long reportedRobots_ = -2;               // the robots' in-shape stretch already announced (-2: none)
+  ros::WallTime robotsReportedAt_;         // the last line about missing robots
 };
 
 /**
