@@ -6,7 +6,8 @@ namespace vf {
 
 Trails::Trails(int agents, int length)
     : trails_(static_cast<std::size_t>(agents)),
-      stride_(static_cast<int>(std::max(1L, (static_cast<long>(agents) * length + kPoints - 1) / kPoints))),
+      stride_(static_cast<int>(std::clamp((static_cast<long>(agents) * length + kPoints - 1) / kPoints, 1L,
+                                          std::max(1L, static_cast<long>(length) / 2)))),
       // Enough kept positions that the trail, with the current position, spans `length` steps.
       kept_(static_cast<std::size_t>(std::max(1, length / stride_))) {}
 

@@ -150,11 +150,26 @@ TEST_F(MarkersTest, SmallFormationsKeepEveryStepOfTheirTrails) {
   }
 }
 
+TEST_F(MarkersTest, TrailsHoldAtMost600PositionsOrTwoPerAgent) {
+  // 100 agents: a position every ceil(100 x 100 / 600) = 17 steps, 5 per trail (steps 17 k).
+  const Formation f = ring(100);
+  Trails trails(100, 100);
+  EXPECT_EQ(trails.stride(), 17);
+  const auto a = markersAfter(f, 400, trails);
+  ASSERT_EQ(trails.of(7).size(), 5u);
+  EXPECT_EQ(trails.of(7).front().head<2>(), Eigen::Vector2d(positionsAt(f, 323).col(7)));
+  EXPECT_EQ(trails.of(7).back().head<2>(), Eigen::Vector2d(positionsAt(f, 391).col(7)));
+  // Per agent, 4 segments between kept positions and one on to step 400.
+  EXPECT_EQ(find(a, "trails", 0).points.size(), 100u * 2 * 5);
+  // Trails of 2 steps never thin: every step kept.
+  EXPECT_EQ(Trails(1000, 2).stride(), 1);
+}
+
 TEST_F(MarkersTest, LargeFormationsThinTheirTrailsToABoundOverTheSameSpan) {
   const int n = 1000, length = 100;
   const Formation f = ring(n);
   Trails trails(n, length);
-  // ceil(1000 x 100 / 2000) = 50: positions of every 50th step, two per trail.
+  // ceil(1000 x 100 / 600) = 167, at most 100 / 2: positions of every 50th step, two per trail.
   ASSERT_EQ(trails.stride(), 50);
   const long last = 337;
   const auto a = markersAfter(f, last, trails);
@@ -179,7 +194,7 @@ TEST_F(MarkersTest, LargeFormationsThinTheirTrailsToABoundOverTheSameSpan) {
 
 TEST_F(MarkersTest, TheArrayHasAFixedHandfulOfMarkersAndGrowsLinearlyWithTheAgents) {
   // The same markers for 6 and 1000 agents (no commands: no arrow); the message at 1000 agents,
-  // with a ring's 2000 edges, under 600 kB (it was 3 MB with a sphere and a strip per agent).
+  // with a ring's 2000 edges, under 500 kB (it was 3 MB with a sphere and a strip per agent).
   std::vector<std::pair<std::string, int>> names6, names1000;
   uint32_t bytes = 0;
   for (int n : {6, 1000}) {
@@ -192,7 +207,7 @@ TEST_F(MarkersTest, TheArrayHasAFixedHandfulOfMarkersAndGrowsLinearlyWithTheAgen
   }
   EXPECT_EQ(names6, names1000);
   EXPECT_EQ(names6.size(), 6u);  // agents, trails, edges, desired_shape 0 and 1, text
-  EXPECT_LT(bytes, 600000u);
+  EXPECT_LT(bytes, 500000u);
 }
 
 }  // namespace
