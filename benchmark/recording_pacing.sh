@@ -10,8 +10,9 @@
 # Pacing, per agent count of VF_RP_PACE (default "100 500"): an unpaced run at h = 0.005 s gives
 # its rate R0; the time step is then chosen so that real time needs R0 / VF_RP_MARGIN steps/s
 # (h = VF_RP_MARGIN / R0, margin default 1.3), and that scenario runs unpaced, then at rate:=1.
-# Target: where the unpaced real-time factor is >= 1.2, the paced run keeps real time: its
-# simulated time over its wall time (from step 0 to the last step) is >= 0.98.
+# Both runs last VF_RP_SECONDS (default 10) of simulated time. Target: where the unpaced
+# real-time factor is >= 1.2, the paced run keeps real time: its simulated time over its wall time
+# (from step 0 to the last step) is >= 0.98.
 #
 # usage: benchmark/recording_pacing.sh
 # environment: VF_RP_RECORD, VF_RP_PACE, VF_RP_MARGIN as above; VF_BENCH_STEPS (steps per run,
@@ -53,8 +54,10 @@ for n in "${pace_counts[@]}"; do
     echo "| $n | n/a | n/a | n/a | n/a | n/a | n/a | n/a |"
     continue
   fi
-  unpaced=$(VF_BENCH_MAKE_FLAGS="--time-step $h" run "$n" || echo "$n - - n/a n/a")
-  paced=$(VF_BENCH_MAKE_FLAGS="--time-step $h" VF_BENCH_ARGS="rate:=1" run "$n" || echo "$n - - n/a n/a")
+  # VF_RP_SECONDS (default 10) of simulated time: the start and the end add a fixed 0.1 s or so.
+  steps=$(awk -v h="$h" -v s="${VF_RP_SECONDS:-10}" 'BEGIN { printf "%d", s / h + 0.999 }')
+  unpaced=$(VF_BENCH_STEPS=$steps VF_BENCH_MAKE_FLAGS="--time-step $h" run "$n" || echo "$n - - n/a n/a")
+  paced=$(VF_BENCH_STEPS=$steps VF_BENCH_MAKE_FLAGS="--time-step $h" VF_BENCH_ARGS="rate:=1" run "$n" || echo "$n - - n/a n/a")
   steps=$(field "$paced" 3) prate=$(field "$paced" 4)
   sim=$(awk -v s="$steps" -v h="$h" 'BEGIN { printf "%.2f", s * h }')
   wall=$(awk -v s="$steps" -v r="$prate" 'BEGIN { if (r + 0 > 0) printf "%.2f", s / r; else print "n/a" }')
