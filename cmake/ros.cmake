@@ -12,7 +12,7 @@ target_sources(variational_formation_ros PRIVATE src/ros/lockstep_monitor.cpp sr
   src/ros/monitor_parameters.cpp src/ros/timed_monitor.cpp src/ros/monitor_outputs.cpp
   src/ros/monitor_shape.cpp src/ros/monitor_robots.cpp src/ros/monitor_goals.cpp src/ros/goal_server.cpp src/ros/monitor_safety.cpp
   src/ros/recorder_bag.cpp src/ros/recorder_commands.cpp
-  src/ros/sensing_hub.cpp src/ros/service_call.cpp src/ros/state_batch.cpp src/ros/periodic_call.cpp)
+  src/ros/sensing_hub.cpp src/ros/service_call.cpp src/ros/state_batch.cpp src/ros/periodic_call.cpp src/ros/pacer.cpp src/ros/trails.cpp)
 add_dependencies(variational_formation_ros ${PROJECT_NAME}_gencfg)
 # catkin's include path is given to each ROS target privately (never exported: catkin_lint).
 target_include_directories(variational_formation_ros SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
@@ -80,6 +80,11 @@ if(CATKIN_ENABLE_TESTING)
   add_rostest(test/ros/manoeuvre_run.test ARGS case:=faults seed:=5 faults:=true)
   # Goals (move_to, /move_base_simple/goal) in a recorded lockstep run (test/ros/goal.test).
   add_rostest(test/ros/goal.test)
+  # The monitor's markers and trails (no master).
+  catkin_add_gtest(test_markers test/ros/test_markers.cpp)
+  target_include_directories(test_markers SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
+  target_link_libraries(test_markers variational_formation_ros gtest_main)
+  target_compile_options(test_markers PRIVATE ${VF_FLAGS})
   # The bounded pool of service calls (no master).
   catkin_add_gtest(test_call_pool test/ros/test_call_pool.cpp)
   target_include_directories(test_call_pool SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})

@@ -23,7 +23,8 @@
 #   default max(600, 120000 / agents), about 10-40 s per run), VF_BENCH_TIMEOUT (s per run,
 #   default 900), VF_BENCH_SAMPLE (s between samples, default 0.5), VF_BENCH_RECORD (1: record and
 #   check exactness; default 0), VF_BENCH_PORT_BASE and VF_BENCH_PORTS (the masters' port range,
-#   default 11500 and 100), VF_BENCH_MAKE_FLAGS (more make_scenario flags, e.g. "--safety 0.25 1 0.2").
+#   default 11500 and 100), VF_BENCH_MAKE_FLAGS (more make_scenario flags, e.g. "--safety 0.25 1 0.2"),
+#   VF_BENCH_ARGS (more formation.launch arguments, e.g. "rate:=1": a paced run).
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 vf_install_dependencies
 vf_build
@@ -89,7 +90,8 @@ summarise_samples() {
 
 mode_supported() {
   [ "$1" = process ] && return 0
-  roslaunch --ros-args variational_formation formation.launch 2>/dev/null | grep -qE "^ +$1[ :(]"
+  # grep reads it all (not -q): under pipefail, roslaunch killed by SIGPIPE would fail the test.
+  roslaunch --ros-args variational_formation formation.launch 2>/dev/null | grep -E "^ +$1[ :(]" >/dev/null
 }
 
 declare -A skip
@@ -115,6 +117,8 @@ for n in "${counts[@]}"; do
     : >"$samples"
     extra=()
     [ "$m" = nodelet ] && extra=(nodelet:=true)
+    read -r -a more <<<"${VF_BENCH_ARGS:-}"
+    extra+=("${more[@]}")
     # No size limit: 600 steps of 1000 agents with their markers make about 1.8 GB.
     [ "$record" = 1 ] && extra+=(record:=true record_max_size:=0 output_dir:="$tmp/out_${m}_$n")
     launched=$EPOCHREALTIME

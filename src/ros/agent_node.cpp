@@ -6,6 +6,7 @@
 #include <ros/callback_queue.h>
 
 #include "variational_formation/core/validation.hpp"
+#include "variational_formation/ros/pacer.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/participants.hpp"
 #include "variational_formation/ros/sensing_hub.hpp"
@@ -16,18 +17,6 @@ namespace vf {
 namespace {
 constexpr double kReportEvery = 5.0;  // seconds between "waiting for ..." lines
 
-/// A function, called once on the queue it is added to.
-class QueuedCall : public ros::CallbackInterface {
- public:
-  explicit QueuedCall(std::function<void()> f) : f_(std::move(f)) {}
-  CallResult call() override {
-    f_();
-    return Success;
-  }
-
- private:
-  std::function<void()> f_;
-};
 }  // namespace
 
 AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
@@ -65,7 +54,10 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   }
 }
 
-AgentNode::~AgentNode() { *alive_ = false; }
+AgentNode::~AgentNode() {
+  *alive_ = false;
+  Pacer::instance().cancel(reinterpret_cast<uint64_t>(this));
+}
 
 std::vector<int> AgentNode::sources() const {
   if (!agent_->board() || sharedBoard_) return agent_->neighbourIds();
@@ -165,9 +157,8 @@ void AgentNode::tryAdvance() {
       // Step k + 1 is due (k + 1 - k0) h / r after the start at step k0.
       const double due = (agent_->step() + 1 - startStep_) * agent_->scenario().timeStep / realTimeFactor_;
       const double wait = due - (now - startedAt_).toSec();
-      if (wait > 0.0) {
-        paceTimer_ = nh_.createWallTimer(ros::WallDuration(wait), [this](const ros::WallTimerEvent&) { tryAdvance(); },
-                                         /*oneshot=*/true);
+      if (wait > Pacer::kGrain) {
+        paceFor(wait);
         return;
       }
     }
@@ -184,6 +175,18 @@ void AgentNode::tryAdvance() {
     publish();
     lastStepAt_ = now;
   }
+}
+
+void AgentNode::paceFor(double wait) {
+  if (pacedStep_ == agent_->step()) return;  // already waiting for this step's release
+  pacedStep_ = agent_->step();
+  const std::shared_ptr<bool> alive = alive_;
+  const auto due = Pacer::Clock::now() + std::chrono::duration_cast<Pacer::Clock::duration>(std::chrono::duration<double>(wait));
+  Pacer::instance().at(due, nh_.getCallbackQueue(), reinterpret_cast<uint64_t>(this), [this, alive] {
+    if (!*alive) return;
+    pacedStep_ = -1;
+    tryAdvance();
+  });
 }
 
 void AgentNode::publish() {

@@ -132,24 +132,45 @@ Marker commandArrow(const Ghost& ghostAt, double radius, const ros::Time& stamp)
   return m;
 }
 
-/// Per agent, a sphere at q_i and a line strip through its trail (at least two points).
-void addAgentsAndTrails(const FormationSnapshot& s, const std::vector<std::deque<Eigen::Vector3d>>& trails,
-                        int agents, double radius, const ros::Time& stamp, visualization_msgs::MarkerArray& out) {
-  for (int i = 0; i < agents; ++i) {
-    Marker m = base("agents", i, Marker::SPHERE, stamp);
-    m.pose.position = point(column3(s.positions, i));
-    m.scale.x = m.scale.y = m.scale.z = 2.0 * radius;
-    m.color = agentColour(i);
-    out.markers.push_back(m);
-
-    Marker trail = base("trails", i, Marker::LINE_STRIP, stamp);
-    trail.scale.x = 0.25 * radius;
-    trail.color = agentColour(i);
-    trail.color.a = 0.6f;
-    for (const auto& p : trails[static_cast<std::size_t>(i)]) trail.points.push_back(point(p));
-    if (trail.points.size() < 2) trail.points.assign(2, point(column3(s.positions, i)));
-    out.markers.push_back(trail);
+/// The agents as one sphere list (a sphere of its colour at each q_i), and their trails as one
+/// line list: per agent, segments through its kept positions (Trails) and on to q_i, in its
+/// colour. Two markers whatever the agent count: rviz draws the same spheres and lines as a
+/// marker per agent would, from a message a few times smaller.
+void addAgentsAndTrails(const FormationSnapshot& s, const Trails& trails, double radius, const ros::Time& stamp,
+                        visualization_msgs::MarkerArray& out) {
+  const int n = trails.agents();
+  Marker agents = base("agents", 0, Marker::SPHERE_LIST, stamp);
+  agents.scale.x = agents.scale.y = agents.scale.z = 2.0 * radius;
+  agents.color = rgba(1.0, 1.0, 1.0, 1.0);  // rviz takes colors[] per point
+  agents.points.reserve(static_cast<std::size_t>(n));
+  agents.colors.reserve(static_cast<std::size_t>(n));
+  Marker lines = base("trails", 0, Marker::LINE_LIST, stamp);
+  lines.scale.x = 0.25 * radius;
+  lines.color = rgba(1.0, 1.0, 1.0, 0.6);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d q = column3(s.positions, i);
+    const std_msgs::ColorRGBA colour = agentColour(i);
+    agents.points.push_back(point(q));
+    agents.colors.push_back(colour);
+    std_msgs::ColorRGBA faded = colour;
+    faded.a = 0.6f;
+    const std::deque<Eigen::Vector3d>& kept = trails.of(i);
+    const Eigen::Vector3d* from = kept.empty() ? &q : &kept.front();
+    const auto segment = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+      lines.points.push_back(point(a));
+      lines.points.push_back(point(b));
+      lines.colors.push_back(faded);
+      lines.colors.push_back(faded);
+    };
+    for (std::size_t k = 1; k < kept.size(); ++k) {
+      segment(*from, kept[k]);
+      from = &kept[k];
+    }
+    // On to the current position (none if it is the last kept one; a dot at the start).
+    if (*from != q || kept.size() < 2) segment(*from, q);
   }
+  out.markers.push_back(agents);
+  out.markers.push_back(lines);
 }
 
 /// The edges, green (no error) to red (|error| >= 10% of s d_ij, s the commanded scale), and the
@@ -212,14 +233,14 @@ Marker statusText(const FormationSnapshot& s, int agents, const Ghost& ghostAt, 
 }  // namespace
 
 visualization_msgs::MarkerArray makeMarkers(const FormationSnapshot& s, const Formation& formation,
-                                            const std::vector<std::deque<Eigen::Vector3d>>& trails,
-                                            const CommandSchedule* schedule, double timeStep) {
+                                            const Trails& trails, const CommandSchedule* schedule,
+                                            double timeStep) {
   visualization_msgs::MarkerArray out;
   const ros::Time stamp = ros::Time::now();
   const int n = formation.agentCount();
   const double radius = markerRadius(formation);
   const Ghost ghostAt(s, formation, schedule, timeStep);
-  addAgentsAndTrails(s, trails, n, radius, stamp, out);
+  addAgentsAndTrails(s, trails, radius, stamp, out);
   addEdgesAndGhostEdges(s, formation, ghostAt, radius, stamp, out);
   out.markers.push_back(ghostAgents(formation, ghostAt, radius, stamp));
   out.markers.push_back(statusText(s, n, ghostAt, radius, stamp));

@@ -38,7 +38,7 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh, bool timed) 
   recording_ = !recorderParam_.empty();
   scenario_ = loadScenario(path_);
   const int n = scenario_.agentCount();
-  trails_.resize(static_cast<std::size_t>(n));
+  trails_ = Trails(n, trailLength_);
   if (!resultFile_.empty()) {
     createParentDirectory(resultFile_, "~result_file");
     announceReplacedResult(resultFile_);

@@ -16,12 +16,7 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
   const ros::WallTime now = ros::WallTime::now();
   if (s.metrics.step == 0) firstStepAt_ = now;
   lastCompletedAt_ = now;
-  for (std::size_t i = 0; i < trails_.size(); ++i) {
-    Eigen::Vector3d p = Eigen::Vector3d::Zero();
-    p.head(s.positions.rows()) = s.positions.col(static_cast<Eigen::Index>(i));
-    trails_[i].push_back(p);
-    if (static_cast<int>(trails_[i].size()) > trailLength_) trails_[i].pop_front();
-  }
+  trails_.add(s.metrics.step, s.positions);
   Published out;
   FormationStatus& status = out.first;
   status = toStatusMessage(s);
@@ -49,9 +44,9 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
     clock.clock = stamp;
     clockPub_.publish(clock);
   }
-  // Markers cost O(n x trail length) per step: built only when someone takes them (the recorder,
-  // a viewer), every marker_every steps, and always at the first and last step so that the
-  // latched one is right. The trails above still get every step.
+  // Markers cost O(n + |E|) per step (trails thinned to a bound, Trails): built only when someone
+  // takes them (the recorder, a viewer), every marker_every steps, and always at the first and
+  // last step so that the latched one is right. The trails above still get every step.
   const long last = scenario_.steps;
   const bool edge = s.metrics.step == 0 || (last > 0 && s.metrics.step == last);
   if (edge || (s.metrics.step % markerEvery_ == 0 && (recording_ || markersPub_.getNumSubscribers() > 0))) {

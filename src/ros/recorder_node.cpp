@@ -112,7 +112,8 @@ void RecorderNode::onBatch(std::size_t source, const ros::MessageEvent<variation
                         msg.id, from.manager.c_str(), event.getPublisherName().c_str(), dropped_);
       continue;
     }
-    record(static_cast<int>(msg.id), boost::make_shared<const AgentState>(msg));
+    // Held by pointer into the batch (which it keeps alive), not copied.
+    record(static_cast<int>(msg.id), AgentState::ConstPtr(event.getConstMessage(), &msg));
   }
 }
 

@@ -80,6 +80,8 @@ class AgentNode {
   /// The monitor's list of issued commands (src/ros/agent_commands.cpp): applies the new ones.
   void onCommands(const ros::MessageEvent<variational_formation::FormationCommands const>& event);
   void tryAdvance();
+  /// tryAdvance() again in `wait` seconds, released by the process's Pacer (once per step).
+  void paceFor(double wait);
   void publish();
   void reportWaiting();
   std::string waitingFor() const;
@@ -107,7 +109,7 @@ class AgentNode {
   long startStep_ = 0;
   std::string monitor_;
   tf2_ros::TransformBroadcaster tf_;
-  ros::WallTimer paceTimer_;
+  long pacedStep_ = -1;  // the step whose release by the Pacer it waits for (-1: none)
   double realTimeFactor_ = 0.0;
   long allowedStep_ = 0;
   bool started_ = false;

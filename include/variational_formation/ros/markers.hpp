@@ -1,8 +1,5 @@
 #pragma once
 
-#include <deque>
-#include <vector>
-
 #include <std_msgs/ColorRGBA.h>
 #include <visualization_msgs/MarkerArray.h>
 
@@ -11,6 +8,7 @@
 #include "variational_formation/core/monitor.hpp"
 #include "variational_formation/core/safety.hpp"
 #include "variational_formation/core/tracking.hpp"
+#include "variational_formation/ros/trails.hpp"
 
 namespace vf {
 
@@ -27,17 +25,21 @@ std_msgs::ColorRGBA agentColour(int agent);
 FormationStatus toStatusMessage(const FormationSnapshot& snapshot);
 
 /**
- * rviz markers of a snapshot in frame world: a sphere per agent, the edges coloured by their
- * distance error (green 0 to red >= 10% of d_ij), a trail per agent, the desired shape as a
- * faint ghost centred on the current centroid, and a text with step, energy and error. Under a
- * commanded motion (`schedule`), the ghost is turned and scaled as the commands have turned and
- * scaled the shape by this step (commandedFrame), and an arrow from the centroid shows v*.
- * @param trails per agent, the recent positions (oldest first).
+ * rviz markers of a snapshot in frame world, a fixed handful of markers whatever the agent count:
+ * the agents (ns `agents`, one SPHERE_LIST: a sphere per agent at q_i, in agentColour(i)), the
+ * edges coloured by their distance error (ns `edges`, one LINE_LIST: 2 points per edge, tail
+ * then head, green 0 to red >= 10% of d_ij), the trails (ns `trails`, one LINE_LIST: per agent,
+ * segments through its kept positions and on to q_i, in its colour), the desired shape as a faint
+ * ghost centred on the current centroid (ns `desired_shape`: edges, id 0, and agents, id 1), and
+ * a text with step, energy and error. Under a commanded motion (`schedule`), the ghost is turned
+ * and scaled as the commands have turned and scaled the shape by this step (commandedFrame), and
+ * an arrow from the centroid shows v*.
+ * @param trails the agents' recent positions (one trail per agent of the formation).
  * @param schedule the commands the agents apply, or nullptr. @param timeStep h [s].
  */
 visualization_msgs::MarkerArray makeMarkers(const FormationSnapshot& snapshot, const Formation& formation,
-                                            const std::vector<std::deque<Eigen::Vector3d>>& trails,
-                                            const CommandSchedule* schedule = nullptr, double timeStep = 0.0);
+                                            const Trails& trails, const CommandSchedule* schedule = nullptr,
+                                            double timeStep = 0.0);
 
 /**
  * The safety filter's markers (a scenario with `safety:`), appended to `out`: per agent its safety

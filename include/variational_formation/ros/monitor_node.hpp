@@ -29,6 +29,7 @@
 #include "variational_formation/ros/goal_server.hpp"
 #include "variational_formation/ros/service_call.hpp"
 #include "variational_formation/ros/state_batch.hpp"
+#include "variational_formation/ros/trails.hpp"
 
 namespace vf {
 
@@ -214,7 +215,7 @@ class MonitorNode {
   ros::Publisher clockPub_;
   bool publishClock_ = false;  // ~publish_clock (lockstep): /clock follows the completed steps, never backwards
   ros::WallTimer watchTimer_;
-  std::vector<std::deque<Eigen::Vector3d>> trails_;
+  Trails trails_{1, 2};  // replaced once the scenario is read
   int trailLength_ = 100;
   long markerEvery_ = 1;
   std::string resultFile_;
