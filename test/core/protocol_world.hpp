@@ -1,7 +1,7 @@
 #pragma once
 // A whole lockstep run without a transport, for the protocol tests: the shipped agents
-// (AgentProtocol, as AgentNode runs it), the monitor's LockstepReferee and a recorder
-// (RecordLedger + StepAssembler), joined by a simulated network whose deliveries, repeats,
+// (AgentProtocol, as AgentNode runs it), the monitor's LockstepReferee and the shipped recorder
+// (RecorderProtocol, as RecorderNode runs it), joined by a simulated network whose deliveries, repeats,
 // reorderings, losses, kills and restarts a test chooses event by event.
 
 #include <algorithm>
@@ -19,8 +19,7 @@
 #include "variational_formation/core/protocol/agent_protocol.hpp"
 #include "variational_formation/core/protocol/recovery.hpp"
 #include "variational_formation/core/protocol/run_referee.hpp"
-#include "variational_formation/core/protocol/step_assembler.hpp"
-#include "variational_formation/core/record_ledger.hpp"
+#include "variational_formation/core/protocol/recorder_protocol.hpp"
 #include "variational_formation/core/variational_integrator.hpp"
 
 namespace vf::test {
@@ -35,6 +34,7 @@ using StatePtr = std::shared_ptr<const State>;
 using Referee = protocol::LockstepReferee<State, long>;
 using Progress = protocol::Progress;
 using AgentProtocol = protocol::AgentProtocol<StatePtr, Progress>;
+using Recorder = protocol::RecorderProtocol<StatePtr, long, long>;  // a status and markers are their step
 
 /// One message on its way. Kinds: a state (to a neighbour, the monitor or the recorder), a
 /// progress (to an agent or the recorder), a status or markers (to the recorder), a recorder
@@ -57,8 +57,7 @@ class World {
         formation_(makeFormation(s)),
         window_(window),
         markerEvery_(markerEvery),
-        ledger_(s.agentCount(), 1024),
-        assembler_(s.agentCount(), [this](long k) { return needsMarkers(k); }) {
+        recorder_(s.agentCount(), 1024, s.steps, [this](long k) { return needsMarkers(k); }, [](long) { return 0L; }) {
     VariationalIntegrator reference(formation_, s.initialPositions, s.initialVelocities, s.timeStep, s.dampingGain,
                                     StartMethod::Variational);
     expected_.push_back(reference.positions());
@@ -97,10 +96,10 @@ class World {
         }
         break;
       case Message::Kind::Status:
-        if (assembler_.addStatus(msg.step, msg.step)) writeWhole();
+        recorderDo(recorder_.step(Recorder::StatusArrived{msg.step, msg.step}));
         break;
       case Message::Kind::Markers:
-        if (assembler_.addMarkers(msg.step, msg.step)) writeWhole();
+        recorderDo(recorder_.step(Recorder::MarkersArrived{msg.step, msg.step}));
         break;
       case Message::Kind::RecorderProgress:
         if (monitor_) {
@@ -190,7 +189,7 @@ class World {
   bool finished() const { return finished_; }
   bool failed() const { return !failure_.empty(); }
   const std::string& failure() const { return failure_; }
-  long writtenThrough() const { return assembler_.handedOutThrough(); }
+  long writtenThrough() const { return recorder_.steps().handedOutThrough(); }
   long delivered() const { return delivered_; }
   long maxPendingSteps() const { return maxPending_; }
   /// The newest step any live agent computed.
@@ -205,7 +204,7 @@ class World {
   /// What each live participant waits for (the monitor's line, the recorder's oldest step).
   std::string waitingFor() const {
     std::string s = monitor_ ? "monitor: " + monitor_->waitingFor("recorder") : "monitor: dead";
-    s += "; recorder: " + assembler_.lacking();
+    s += "; recorder: " + recorder_.steps().lacking();
     if (std::getenv("PROTOCOL_TRACE")) {
       for (std::size_t i = 0; i < agents_.size(); ++i) {
         const AgentProtocol* a = agents_[i].get();
@@ -387,49 +386,58 @@ class World {
     monitorUpdate();
   }
 
-  void record(int i, const State& s) {
-    const auto arrival = ledger_.addState(i, s.step, s.position, s.previous_position);
-    if (arrival == RecordLedger::Arrival::Differs) violations_.push_back("a repeat differs from the first copy");
-    if (arrival != RecordLedger::Arrival::New) return;
-    const auto& q = expected_[static_cast<std::size_t>(s.step)];
-    const auto& qPrev = expected_[static_cast<std::size_t>(std::max(0L, s.step - 1))];
-    for (int c = 0; c < scenario_.dimension; ++c) {
-      if (s.position[static_cast<std::size_t>(c)] != q(c, i) ||
-          (s.step > 0 && s.previous_position[static_cast<std::size_t>(c)] != qPrev(c, i))) {
-        violations_.push_back("agent " + std::to_string(i) + "'s step " + std::to_string(s.step) +
-                              " differs from the centralised run");
-        break;
+  void record(int i, const State& s) { recorderDo(recorder_.step(Recorder::StateArrived{i, std::make_shared<const State>(s)})); }
+  /// Carries out what the recorder said: each written step is checked (in order, whole, every
+  /// state equal to the centralised run) and its progress goes to the monitor.
+  void recorderDo(const Recorder::Ready& r) {
+    if (!r.failed.empty()) violations_.push_back("the recorder failed: " + r.failed);
+    if (recorder_.refused() > 0) violations_.push_back("a new state of a written step");
+    maxPending_ = std::max(maxPending_, static_cast<long>(recorder_.steps().pendingSteps() + r.write.size()));
+    for (const Recorder::Write& w : r.write) {
+      if (w.step.step != written_ + 1) violations_.push_back("step " + std::to_string(w.step.step) + " written out of order");
+      written_ = w.step.step;
+      const auto& q = expected_[static_cast<std::size_t>(w.step.step)];
+      const auto& qPrev = expected_[static_cast<std::size_t>(std::max(0L, w.step.step - 1))];
+      for (int i = 0; i < agentCount(); ++i) {
+        const State& st = *w.step.states[static_cast<std::size_t>(i)];
+        for (int c = 0; c < scenario_.dimension; ++c) {
+          if (st.step != w.step.step || st.position[static_cast<std::size_t>(c)] != q(c, i) ||
+              (st.step > 0 && st.previous_position[static_cast<std::size_t>(c)] != qPrev(c, i))) {
+            violations_.push_back("agent " + std::to_string(i) + "'s step " + std::to_string(w.step.step) +
+                                  " differs from the centralised run");
+            break;
+          }
+        }
       }
     }
-    if (!assembler_.addState(i, s.step, s.step)) violations_.push_back("a new state of a written step");
-    writeWhole();
-  }
-  void writeWhole() {
-    maxPending_ = std::max(maxPending_, static_cast<long>(assembler_.pendingSteps()));
-    for (const auto& whole : assembler_.takeWhole()) {
-      if (whole.step != written_ + 1) violations_.push_back("step " + std::to_string(whole.step) + " written out of order");
-      written_ = whole.step;
-    }
-    if (written_ > recorderReported_) {
-      recorderReported_ = written_;
-      recorderFinished_ = scenario_.steps > 0 && written_ >= scenario_.steps;
-      send({Message::Kind::RecorderProgress, Message::Monitor, {}, {}, written_, recorderFinished_, -1});
+    if (r.report) {
+      recorderReported_ = r.report->completedStep;
+      recorderFinished_ = r.report->state == Progress::State::Finished;
+      send({Message::Kind::RecorderProgress, Message::Monitor, {}, {}, recorderReported_, recorderFinished_, -1});
     }
   }
   void recorderGotProgress(const Progress& p) {
-    recorderProgress_ = std::max(recorderProgress_, p.completedStep);
     if (p.state == Progress::State::Failed) failure_ = p.reason;
+    recorderDo(recorder_.step(Recorder::MonitorProgress{p}));
   }
+  /// The recorder's catch-up timer (a second of its clock per call): the histories of the agents
+  /// and the monitor, as the node fetches them.
   void recorderCatchUp() {
-    for (int i = 0; i < agentCount(); ++i) {
-      if (ledger_.statesBelow(i) > written_ + 1) continue;  // it holds its part of the next step
-      std::vector<State> states;
-      if (agents_[static_cast<std::size_t>(i)]) states = held(*agents_[static_cast<std::size_t>(i)], i);
-      if (monitor_) states.insert(states.end(), monitor_->unrecordedStates(i).begin(), monitor_->unrecordedStates(i).end());
-      for (const State& s : states) {
-        if (!ledger_.holdsState(i, s.step)) record(i, s);
+    recorderClock_ += 1.0;
+    const Recorder::Ready tick = recorder_.step(Recorder::Tick{recorderClock_});
+    if (!tick.catchUp) return;
+    Recorder::HistoriesArrived answers{recorderClock_, {}};
+    for (int i : tick.fetch) {
+      if (const AgentProtocol* a = agents_[static_cast<std::size_t>(i)].get()) {
+        answers.answers.emplace_back(i, std::vector<StatePtr>(a->history(i)->begin(), a->history(i)->end()));
       }
     }
+    for (int i : tick.fetch) {
+      if (!monitor_) continue;
+      answers.answers.emplace_back(i, std::vector<StatePtr>());
+      for (const State& st : monitor_->unrecordedStates(i)) answers.answers.back().second.push_back(std::make_shared<const State>(st));
+    }
+    recorderDo(recorder_.step(answers));
   }
 
   Scenario scenario_;
@@ -440,9 +448,9 @@ class World {
   std::map<int, State> latched_;  // each agent's newest published state
   std::optional<Progress> latchedProgress_;
   std::unique_ptr<Referee> monitor_;
-  RecordLedger ledger_;
-  protocol::StepAssembler<long, long, long> assembler_;
-  long latchedStatus_ = -1, written_ = -1, recorderReported_ = -1, recorderProgress_ = -1, maxPending_ = 0, delivered_ = 0;
+  Recorder recorder_;
+  double recorderClock_ = 0.0;
+  long latchedStatus_ = -1, written_ = -1, recorderReported_ = -1, maxPending_ = 0, delivered_ = 0;
   bool recorderFinished_ = false, finished_ = false;
   std::string failure_;
   std::vector<Message> inFlight_;
