@@ -40,9 +40,9 @@ using variational_formation::RunProgress;
  * the agents back afterwards.
  *
  * What to write when, what to report and when to catch up is protocol::RecorderProtocol's; the
- * node moves messages to it and writes what it says. Steps are written whole and in order (states with their transforms, status, markers), once all
- * of step k has arrived and after step k - 1, so the bag is in time order however late a state
- * came. The bag holds each (agent, step) state, each status and each step's markers once: a copy that
+ * node moves messages to it and writes what it says. Steps are written whole and in order
+ * (states with their transforms, status, markers), once all of step k has arrived and after
+ * step k - 1, so the bag is in time order however late a state came. The bag holds each (agent, step) state, each status and each step's markers once: a copy that
  * arrives again (from a history fetched while the topic was still delivering it, or from an
  * agent that republishes after a restart) is not written, and a repeated state that differs
  * from the written one, bit for bit, fails the run (RecordLedger).
