@@ -3,6 +3,7 @@ add_library(variational_formation_ros src/ros/agent_commands.cpp src/ros/agent_n
   src/ros/monitor_node.cpp
   src/ros/output_files.cpp
   src/ros/participants.cpp
+  src/ros/progress_message.cpp
   src/ros/recorder_node.cpp)
 # The time-driven agent (doc/robots.md), selected by the agent's ~mode.
 target_sources(variational_formation_ros PRIVATE src/ros/timed_agent_node.cpp src/ros/timed_agent_outputs.cpp

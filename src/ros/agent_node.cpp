@@ -9,6 +9,7 @@
 #include "variational_formation/ros/pacer.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/progress_message.hpp"
 #include "variational_formation/ros/sensing_hub.hpp"
 #include "variational_formation/ros/state_batch.hpp"
 
@@ -29,7 +30,10 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   managers_ = agentManagers(nh, pnh);
   const std::shared_ptr<SensingBoard> board = SensingHub::board(nh, scenario, managers_);
   sharedBoard_ = board != nullptr;
-  agent_ = std::make_unique<LockstepAgent>(scenario, id, StartMethod::Variational, board);
+  protocol_ = std::make_unique<Protocol>(
+      LockstepAgent(scenario, id, StartMethod::Variational, board),
+      [this](const LockstepAgent& a, const std::string& failure) { return makeState(a, failure); }, realTimeFactor_,
+      [] { return ros::WallTime::now().toSec(); }, Pacer::kGrain);
   name_ = "agent_" + std::to_string(id);
   // Frames carry the namespace, so that two formations side by side have distinct frames.
   const std::string ns = framePrefix(nh);
@@ -37,14 +41,13 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   worldFrame_ = worldFrame(pnh);
   statePub_ = nh.advertise<AgentState>(name_ + "/state", 1000, /*latch=*/true);
   for (int j = 0; j < scenario.agentCount(); ++j) owners_.push_back(agentNodeName(nh, j));
-  neighbourHistory_.resize(agent_->neighbourIds().size());
   // Served from the start, so that restarting neighbours can ask; the subscriptions wait for
   // start(), which resumes the agent before any state reaches it.
   recallServer_ = nh.advertiseService(name_ + "/recall", &AgentNode::onRecall, this);
   historyServer_ = nh.advertiseService(name_ + "/history", &AgentNode::onHistory, this);
   for (const std::string& w : scenario.warnings) ROS_WARN("%s: %s", name_.c_str(), w.c_str());
   ROS_INFO("%s: scenario '%s' (%s), %d neighbours, kappa %g, h %g, %ld steps%s, real-time factor %g, monitor %s",
-           name_.c_str(), scenario.name.c_str(), path.c_str(), static_cast<int>(agent_->neighbourIds().size()),
+           name_.c_str(), scenario.name.c_str(), path.c_str(), static_cast<int>(agent().neighbourIds().size()),
            scenario.dampingGain, scenario.timeStep, scenario.steps, scenario.steps == 0 ? " (unbounded)" : "",
            realTimeFactor_, monitor_.c_str());
   if (scenario.safety) {
@@ -60,22 +63,22 @@ AgentNode::~AgentNode() {
 }
 
 std::vector<int> AgentNode::sources() const {
-  if (!agent_->board() || sharedBoard_) return agent_->neighbourIds();
+  if (!agent().board() || sharedBoard_) return agent().neighbourIds();
   std::vector<int> all;
-  for (int j = 0; j < agent_->scenario().agentCount(); ++j) {
-    if (j != agent_->id()) all.push_back(j);
+  for (int j = 0; j < agent().scenario().agentCount(); ++j) {
+    if (j != agent().id()) all.push_back(j);
   }
   return all;
 }
 
 void AgentNode::wakeWhenSensed() {
-  if (!sharedBoard_ || wakeStep_ == agent_->step()) return;
-  wakeStep_ = agent_->step();
+  if (!sharedBoard_ || wakeStep_ == agent().step()) return;
+  wakeStep_ = agent().step();
   ros::CallbackQueueInterface* queue = nh_.getCallbackQueue();
   const std::shared_ptr<bool> alive = alive_;
-  agent_->board()->whenComplete(agent_->step(), [this, queue, alive] {
+  agent().board()->whenComplete(agent().step(), [this, queue, alive] {
     queue->addCallback(boost::make_shared<QueuedCall>([this, alive] {
-      if (*alive) tryAdvance();
+      if (*alive) carryOut(protocol_->step(Protocol::Wake{}));
     }), reinterpret_cast<uint64_t>(this));
   });
 }
@@ -85,28 +88,34 @@ void AgentNode::drop(const std::string& why) {
   ROS_WARN_THROTTLE(1.0, "%s: dropped %s; %ld dropped so far", name_.c_str(), why.c_str(), dropped_);
 }
 
+void AgentNode::carryOut(const Protocol::Ready& ready) {
+  if (!ready.failed.empty()) ROS_ERROR("%s: %s; ending the run", name_.c_str(), ready.failed.c_str());
+  for (const AgentState::ConstPtr& state : ready.publish) publish(state);
+  if (!ready.dropped.empty()) drop(ready.dropped);
+  if (!ready.over.empty()) ROS_INFO("%s: %s", name_.c_str(), ready.over.c_str());
+  if (ready.wakeWhenSensed) wakeWhenSensed();
+  if (ready.wakeAfter > 0.0) paceFor(ready.wakeAfter);
+}
+
+void AgentNode::paceFor(double wait) {
+  if (pacedStep_ == agent().step()) return;  // already waiting for this step's release
+  pacedStep_ = agent().step();
+  const std::shared_ptr<bool> alive = alive_;
+  const auto due = Pacer::Clock::now() + std::chrono::duration_cast<Pacer::Clock::duration>(std::chrono::duration<double>(wait));
+  Pacer::instance().at(due, nh_.getCallbackQueue(), reinterpret_cast<uint64_t>(this), [this, alive] {
+    if (!*alive) return;
+    pacedStep_ = -1;
+    carryOut(protocol_->step(Protocol::Wake{}));
+  });
+}
+
 void AgentNode::onNeighbourState(int neighbour, const ros::MessageEvent<AgentState const>& event) {
-  try {
-    const AgentState& msg = *event.getConstMessage();
-    if (!fromAgent(event, owners_[static_cast<std::size_t>(neighbour)], managers_)) {
-      drop("a state on agent_" + std::to_string(neighbour) + "'s topic from " + event.getPublisherName() +
-           ", which does not own it");
-      return;
-    }
-    const long sender = static_cast<long>(msg.id) == neighbour ? neighbour : -1;
-    const auto receipt = agent_->receive(sender, msg.step, msg.position, msg.previous_position);
-    if (receipt == LockstepAgent::Receipt::Accepted) {
-      const std::vector<int>& ids = agent_->neighbourIds();
-      const auto k = static_cast<std::size_t>(std::find(ids.begin(), ids.end(), neighbour) - ids.begin());
-      if (k < ids.size()) neighbourHistory_[k].push_back(event.getConstMessage());
-      tryAdvance();
-    } else if (receipt != LockstepAgent::Receipt::Duplicate) {
-      drop("a state from agent_" + std::to_string(neighbour) + " (step " + std::to_string(msg.step) +
-           "): " + LockstepAgent::describe(receipt));
-    }
-  } catch (const std::exception& e) {
-    drop(std::string("a state: ") + e.what());
+  if (!fromAgent(event, owners_[static_cast<std::size_t>(neighbour)], managers_)) {
+    drop("a state on agent_" + std::to_string(neighbour) + "'s topic from " + event.getPublisherName() +
+         ", which does not own it");
+    return;
   }
+  carryOut(protocol_->step(Protocol::StateArrived{neighbour, event.getConstMessage()}));
 }
 
 void AgentNode::onProgress(const ros::MessageEvent<RunProgress const>& event) {
@@ -115,131 +124,39 @@ void AgentNode::onProgress(const ros::MessageEvent<RunProgress const>& event) {
     return;
   }
   const RunProgress& p = *event.getConstMessage();
-  // Once its run is over, an agent keeps that run's final word: a monitor started later (which
-  // says that the run is over) does not change it.
-  if (exitStatus_ >= 0) return;
-  if (!hasProgress_ || p.completed_step >= lastProgress_.completed_step) {
-    lastProgress_ = p;
-    hasProgress_ = true;
-    while (!history_.empty() && history_.front()->step <= p.completed_step) history_.pop_front();
-    for (auto& held : neighbourHistory_) {
-      while (!held.empty() && held.front()->step <= p.completed_step) held.pop_front();
-    }
-  }
-  if (p.state == RunProgress::FINISHED || p.state == RunProgress::FAILED) {
-    // Stay up, idle: a respawning agent that exited would only be restarted.
-    if (exitStatus_ < 0) {
-      ROS_INFO("%s: the run is over at step %ld (%s); idle until shut down", name_.c_str(), agent_->step(),
-               p.state == RunProgress::FINISHED ? "finished" : ("failed: " + p.reason).c_str());
-    }
-    exitStatus_ = p.state == RunProgress::FINISHED ? 0 : 1;
-  } else {
-    allowedStep_ = std::max(allowedStep_, static_cast<long>(p.allowed_step));
-    commandsCounted_ = p.commands;
-    tryAdvance();
-  }
+  carryOut(protocol_->step(Protocol::ProgressArrived{agentProgressOf(p), p}));
 }
 
-void AgentNode::tryAdvance() {
-  while (exitStatus_ < 0 && failure_.empty() && !agent_->finished() && agent_->step() < allowedStep_ &&
-         commandsHeld_ >= commandsCounted_) {
-    if (!agent_->ready()) {
-      wakeWhenSensed();
-      return;
-    }
-    const ros::WallTime now = ros::WallTime::now();
-    if (!started_) {
-      started_ = true;
-      startedAt_ = now;
-      startStep_ = agent_->step();
-    }
-    if (realTimeFactor_ > 0.0) {
-      // Step k + 1 is due (k + 1 - k0) h / r after the start at step k0.
-      const double due = (agent_->step() + 1 - startStep_) * agent_->scenario().timeStep / realTimeFactor_;
-      const double wait = due - (now - startedAt_).toSec();
-      if (wait > Pacer::kGrain) {
-        paceFor(wait);
-        return;
-      }
-    }
-    agent_->advance();
-    if (!agent_->finite()) {
-      // Never publish a non-finite state: report the divergence with the last good one, and let
-      // the monitor end the run (doc/distributed.md).
-      failure_ = "step " + std::to_string(agent_->step()) + " is not finite (the run diverged)";
-      ROS_ERROR("%s: %s; ending the run", name_.c_str(), failure_.c_str());
-      agent_->undo();
-      publish();
-      return;
-    }
-    publish();
-    lastStepAt_ = now;
-  }
-}
-
-void AgentNode::paceFor(double wait) {
-  if (pacedStep_ == agent_->step()) return;  // already waiting for this step's release
-  pacedStep_ = agent_->step();
-  const std::shared_ptr<bool> alive = alive_;
-  const auto due = Pacer::Clock::now() + std::chrono::duration_cast<Pacer::Clock::duration>(std::chrono::duration<double>(wait));
-  Pacer::instance().at(due, nh_.getCallbackQueue(), reinterpret_cast<uint64_t>(this), [this, alive] {
-    if (!*alive) return;
-    pacedStep_ = -1;
-    tryAdvance();
-  });
-}
-
-void AgentNode::publish() {
+AgentState::ConstPtr AgentNode::makeState(const LockstepAgent& a, const std::string& failure) const {
   // Built once and published as a pointer to const: subscribers in the same process (nodelets in
   // one manager) receive this very object, without a copy or serialisation.
   const AgentStatePtr state = boost::make_shared<AgentState>();
   AgentState& msg = *state;
-  msg.header.stamp.fromSec(agent_->time());
+  msg.header.stamp.fromSec(a.time());
   msg.header.frame_id = worldFrame_;
-  msg.id = static_cast<uint32_t>(agent_->id());
-  msg.step = agent_->step();
-  msg.time = agent_->time();
-  msg.position = agent_->position();
-  msg.previous_position = agent_->previousPosition();
+  msg.id = static_cast<uint32_t>(a.id());
+  msg.step = a.step();
+  msg.time = a.time();
+  msg.position = a.position();
+  msg.previous_position = a.previousPosition();
   msg.dropped = static_cast<uint32_t>(dropped_);
-  msg.constraints_active = static_cast<uint32_t>(agent_->constraintsActive());
-  msg.failure = failure_;
-  const AgentState::ConstPtr published = state;
-  statePub_.publish(published);
-  history_.push_back(published);
-  if (StateBatch* batch = StateBatch::local()) batch->add(published);  // in an agent_manager
-
-  tf_.sendTransform(frameAt(msg.header, frame_, msg.position));
+  msg.constraints_active = static_cast<uint32_t>(a.constraintsActive());
+  msg.failure = failure;
+  return state;
 }
 
-std::string AgentNode::waitingFor() const {
-  if (!failure_.empty()) return "the monitor to end the run (" + failure_ + ")";
-  if (agent_->finished()) return "the monitor to end the run (last step " + std::to_string(agent_->step()) + " done)";
-  if (agent_->step() >= allowedStep_) {
-    return allowedStep_ == 0 ? "the monitor " + monitor_ + " to start the run (it waits for every participant)"
-                             : "the monitor " + monitor_ + " to allow step " + std::to_string(agent_->step() + 1) +
-                                   " (flow control: it or the recorder is behind)";
-  }
-  if (commandsHeld_ < commandsCounted_) {
-    return "command " + std::to_string(commandsHeld_ + 1) + " of " + std::to_string(commandsCounted_) +
-           " on the monitor's latched `command`";
-  }
-  std::string missing;
-  for (int j : agent_->neighbourIds()) {
-    if (!agent_->holdsNeighbourStep(j)) missing += (missing.empty() ? "" : ", ") + std::string("agent_") + std::to_string(j);
-  }
-  if (missing.empty()) {  // with safety: every agent's state at the step (doc/distributed.md, "Sensing")
-    for (int j : agent_->missingSensed(5)) missing += (missing.empty() ? "" : ", ") + std::string("agent_") + std::to_string(j);
-    if (!missing.empty()) missing += " (sensing)";
-  }
-  return missing.empty() ? "its pacing timer" : "the state at step " + std::to_string(agent_->step()) + " of " + missing;
+void AgentNode::publish(const AgentState::ConstPtr& state) {
+  statePub_.publish(state);
+  if (StateBatch* batch = StateBatch::local()) batch->add(state);  // in an agent_manager
+  tf_.sendTransform(frameAt(state->header, frame_, state->position));
 }
 
 void AgentNode::reportWaiting() {
-  if (exitStatus_ >= 0) return;
-  const ros::WallTime last = lastStepAt_.isZero() ? lastReportAt_ : std::max(lastStepAt_, lastReportAt_);
+  if (protocol_->exitStatus() >= 0) return;
+  const double stepAt = protocol_->lastStepAt();
+  const ros::WallTime last = stepAt < 0.0 ? lastReportAt_ : std::max(ros::WallTime(stepAt), lastReportAt_);
   if (secondsSince(last) < kReportEvery) return;
-  ROS_INFO("%s: at step %ld, waiting for %s", name_.c_str(), agent_->step(), waitingFor().c_str());
+  ROS_INFO("%s: at step %ld, waiting for %s", name_.c_str(), agent().step(), protocol_->waitingFor(monitor_).c_str());
   lastReportAt_ = ros::WallTime::now();
 }
 
@@ -254,7 +171,7 @@ void AgentNode::start(const Recovery& recovery) {
       boost::function<void(const ros::MessageEvent<variational_formation::FormationCommands const>&)>(
           [this](const ros::MessageEvent<variational_formation::FormationCommands const>& e) { onCommands(e); }),
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
-  publish();  // the first state (step 0, or the recovered one), latched
+  carryOut(protocol_->start());  // the first state (step 0, or the recovered one), latched
   lastReportAt_ = ros::WallTime::now();
   // Every 2.5 s (a waiting line every 5 s at most), from the process's one PeriodicCall thread:
   // a manager holds up to thousands of agents, and a roscpp timer each would stall it.
@@ -264,8 +181,8 @@ void AgentNode::start(const Recovery& recovery) {
 int AgentNode::run() {
   start(askHolders());
   while (ros::ok()) ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.1));
-  ROS_INFO("%s: done at step %ld, %ld states dropped", name_.c_str(), agent_->step(), dropped_);
-  return exitStatus_ < 0 ? 0 : exitStatus_;
+  ROS_INFO("%s: done at step %ld, %ld states dropped", name_.c_str(), agent().step(), dropped_);
+  return protocol_->exitStatus() < 0 ? 0 : protocol_->exitStatus();
 }
 
 }  // namespace vf

@@ -2,8 +2,6 @@
 // "Crash recovery"): after a restart it asks who holds its newest state and resumes from it; it
 // answers `~recall` (the newest state it holds of an agent) and `~history` (its own recent states
 // or a neighbour's) for others that restart.
-#include <algorithm>
-
 #include "variational_formation/ros/agent_node.hpp"
 #include "variational_formation/ros/participants.hpp"
 
@@ -12,7 +10,7 @@ namespace vf {
 AgentNode::Recovery AgentNode::askHolders() const {
   // With an own board every agent holds our newest state: one that used our last step may be
   // ahead of the neighbours and the monitor (doc/distributed.md, "Sensing").
-  return recallNewest(nh_, agent_->id(), sources(), monitor_);
+  return recallNewest(nh_, agent().id(), sources(), monitor_);
 }
 
 void AgentNode::resume(const Recovery& r) {
@@ -24,7 +22,7 @@ void AgentNode::resume(const Recovery& r) {
     return;
   }
   try {
-    agent_->resume(best, found.position, found.previous_position);
+    protocol_->resume(best, found.position, found.previous_position);
     ROS_INFO("%s: recovered step %ld from %s; resuming", name_.c_str(), best, from.c_str());
   } catch (const std::exception& e) {
     ROS_WARN("%s: cannot resume from %s (%s): starting from the scenario", name_.c_str(), from.c_str(), e.what());
@@ -33,7 +31,7 @@ void AgentNode::resume(const Recovery& r) {
 
 bool AgentNode::onRecall(RecallState::Request& request, RecallState::Response& response) {
   long step = -1;
-  response.held = agent_->neighbourState(static_cast<int>(request.id), step, response.position,
+  response.held = agent().neighbourState(static_cast<int>(request.id), step, response.position,
                                          response.previous_position);
   response.step = step;
   return true;
@@ -41,19 +39,11 @@ bool AgentNode::onRecall(RecallState::Request& request, RecallState::Response& r
 
 bool AgentNode::onHistory(RecallHistory::Request& request, RecallHistory::Response& response) {
   // Its own states, or those it holds of the neighbour request.id.
-  const std::vector<int>& ids = agent_->neighbourIds();
-  const auto k = std::find(ids.begin(), ids.end(), static_cast<int>(request.id)) - ids.begin();
-  const std::deque<AgentState::ConstPtr>* held = nullptr;
-  if (request.id == agent_->id()) {
-    held = &history_;
-  } else if (k < static_cast<long>(ids.size())) {
-    held = &neighbourHistory_[static_cast<std::size_t>(k)];
-  }
-  if (held) {
+  if (const auto* held = protocol_->history(static_cast<int>(request.id))) {
     for (const AgentState::ConstPtr& state : *held) response.states.push_back(*state);
   }
-  response.progress = lastProgress_;
-  response.has_progress = hasProgress_;
+  response.progress = protocol_->lastProgress();
+  response.has_progress = protocol_->hasProgress();
   return true;
 }
 

@@ -3,32 +3,13 @@
 #include "variational_formation/core/protocol/recovery.hpp"
 #include "variational_formation/ros/monitor_node.hpp"
 #include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/progress_message.hpp"
 
 namespace vf {
 
 namespace {
 constexpr double kCheckAfter = 1.0;  // a step stalled this long makes the monitor look for dead participants
 constexpr double kReportEvery = 5.0;
-
-uint8_t toMessageState(protocol::Progress::State s) {
-  switch (s) {
-    case protocol::Progress::State::Waiting: return RunProgress::WAITING;
-    case protocol::Progress::State::Running: return RunProgress::RUNNING;
-    case protocol::Progress::State::Finished: return RunProgress::FINISHED;
-    case protocol::Progress::State::Failed: break;
-  }
-  return RunProgress::FAILED;
-}
-
-RunProgress toMessage(const protocol::Progress& p) {
-  RunProgress m;
-  m.state = toMessageState(p.state);
-  m.completed_step = p.completedStep;
-  m.allowed_step = p.allowedStep;
-  m.converged_step = p.convergedStep;
-  m.reason = p.reason;
-  return m;
-}
 }  // namespace
 
 LockstepMonitor::LockstepMonitor(ros::NodeHandle& nh, ros::NodeHandle& pnh) : MonitorNode(nh, pnh, false) {

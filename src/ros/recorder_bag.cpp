@@ -60,41 +60,30 @@ void RecorderNode::write(const std::string& topic, const M& msg, const ros::Time
   }
 }
 
-void RecorderNode::flush() {
-  // Steps are written whole and in order, so the bag's messages are in time order: readers that
-  // trust it (Python's rosbag merges chunks assuming it) see every stream in step order.
-  // A step waits for every command its status counts (the monitor stamps none at or before a
-  // step whose status is out): the list comes on its own connection, possibly after the status.
-  const auto commandsHeld = [this](const Steps::Step& step) {
-    return commands_.commands.size() >= step.status->commands;
-  };
-  for (const Steps::Step& step : steps_->takeWhole(commandsHeld)) {
-    writeCommandsUpTo(step.step);
-    // The step's transforms in one /tf message, as a broadcaster of many frames sends them: a
-    // bag message costs the same whatever it holds, and 1000 agents wrote 2000 a step.
-    tf2_msgs::TFMessage tf;
-    tf.transforms.reserve(step.states.size());
-    for (std::size_t i = 0; i < step.states.size(); ++i) {
-      const AgentState& msg = *step.states[i];
-      write(stateTopics_[i], msg, msg.header.stamp);
-      tf.transforms.push_back(frameAt(msg.header, frameIds_[i], msg.position));
-    }
-    if (!tf.transforms.empty()) write("/tf", tf, tf.transforms.front().header.stamp);
-    write(statusTopic_, *step.status, step.status->header.stamp);
-    if (step.hasMarkers) write(markersTopic_, *step.markers, markersStamp(*step.markers));
+void RecorderNode::writeStep(const Protocol::Write& w) {
+  // Steps come whole and in order, so the bag's messages are in time order: readers that trust
+  // it (Python's rosbag merges chunks assuming it) see every stream in step order.
+  const Protocol::Step& step = w.step;
+  if (w.commands > 0) writeListedCommands(w.commands, step.step);
+  // The step's transforms in one /tf message, as a broadcaster of many frames sends them: a
+  // bag message costs the same whatever it holds, and 1000 agents wrote 2000 a step.
+  tf2_msgs::TFMessage tf;
+  tf.transforms.reserve(step.states.size());
+  for (std::size_t i = 0; i < step.states.size(); ++i) {
+    const AgentState& msg = *step.states[i];
+    write(stateTopics_[i], msg, msg.header.stamp);
+    tf.transforms.push_back(frameAt(msg.header, frameIds_[i], msg.position));
   }
-  report();
+  if (!tf.transforms.empty()) write("/tf", tf, tf.transforms.front().header.stamp);
+  write(statusTopic_, *step.status, step.status->header.stamp);
+  if (step.hasMarkers) write(markersTopic_, *step.markers, markersStamp(*step.markers));
 }
 
-void RecorderNode::writeCommandsUpTo(long step) {
-  std::size_t through = commandsInBag_;
-  while (through < commands_.commands.size() && commands_.commands[through].step <= step) ++through;
-  if (through == commandsInBag_) return;
+void RecorderNode::writeListedCommands(std::size_t count, long step) {
   variational_formation::FormationCommands so_far;
   so_far.header.stamp = ros::Time(static_cast<double>(step) * timeStep_);
-  so_far.commands.assign(commands_.commands.begin(), commands_.commands.begin() + static_cast<long>(through));
+  so_far.commands.assign(commands_.commands.begin(), commands_.commands.begin() + static_cast<long>(count));
   write(commandsTopic_, so_far, so_far.header.stamp);
-  commandsInBag_ = through;
 }
 
 void RecorderNode::close(const std::string& how) {
@@ -103,7 +92,7 @@ void RecorderNode::close(const std::string& how) {
   bag_.close();
   ROS_INFO("recorder: %s closed (%s): %ld messages, %ld repeated states not written again (%ld equal to the "
            "written copy bit for bit, %ld too old to compare), %ld dropped", path_.c_str(), how.c_str(), written_,
-           repeats_, repeats_ - uncompared_, uncompared_, dropped_);
+           protocol_->repeats(), protocol_->repeats() - protocol_->uncompared(), protocol_->uncompared(), dropped_);
 }
 
 }  // namespace vf

@@ -36,13 +36,14 @@ void RecorderNode::onCommands(const ros::MessageEvent<variational_formation::For
                       event.getPublisherName().c_str(), monitor_.c_str());
     return;
   }
-  // The list only grows (a restarted monitor goes on from the kept one): an older copy that
-  // arrives late changes nothing.
-  if (event.getConstMessage()->commands.size() < commands_.commands.size()) return;
-  commands_ = *event.getConstMessage();
-  commandsInBag_ = std::min(commandsInBag_, commands_.commands.size());
-  writeCommandsFile();
-  flush();  // steps that waited for these commands
+  std::vector<long> stamps;
+  for (const auto& m : event.getConstMessage()->commands) stamps.push_back(m.step);
+  const Protocol::Ready ready = protocol_->step(Protocol::CommandsArrived{stamps});
+  if (ready.takeCommands) {  // the newest list (an older copy that arrives late is not)
+    commands_ = *event.getConstMessage();
+    writeCommandsFile();
+  }
+  carryOut(ready);  // steps that waited for these commands
 }
 
 void RecorderNode::writeCommandsFile() const {

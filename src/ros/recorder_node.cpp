@@ -9,6 +9,7 @@
 #include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/progress_message.hpp"
 #include "variational_formation/ros/service_call.hpp"
 
 namespace vf {
@@ -21,7 +22,7 @@ const uint32_t kQueue = static_cast<uint32_t>(kBuffers.queue);
 
 }  // namespace
 
-RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), states_(1, 1) {
+RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   scenario_ = loadScenario(requiredParam<std::string>(pnh, "scenario"));
   const Scenario& scenario = scenario_;
   path_ = outputPath(nh, requiredParam<std::string>(pnh, "bag"));
@@ -32,8 +33,9 @@ RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh),
   lastStep_ = scenario.steps;
   timeStep_ = scenario.timeStep;
   const int n = scenario.agentCount();
-  states_ = RecordLedger(n, kBuffers.keptSteps);
-  steps_ = std::make_unique<Steps>(n, [this](long step) { return needsMarkers(step); });
+  protocol_ = std::make_unique<Protocol>(
+      n, kBuffers.keptSteps, lastStep_, [this](long step) { return needsMarkers(step); },
+      [](const FormationStatus::ConstPtr& status) { return static_cast<long>(status->commands); });
   const double splitMb = optionalParam(pnh, "split_size", 256.0);
   const double maxMb = optionalParam(pnh, "max_size", 1024.0);
   if (!(splitMb >= 0.0 && splitMb < 1e9)) throw InvalidInput("~split_size: must be in [0, 1e9) MB, got " + std::to_string(splitMb));
@@ -84,8 +86,6 @@ RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh),
           [this](const ros::MessageEvent<RunProgress const>& e) { onMonitorProgress(e); })));
   setUpCommands(nh, pnh);
   progressPub_ = pnh.advertise<RunProgress>("progress", 10, true);
-  progress_.state = RunProgress::WAITING;
-  progress_.completed_step = -1;
   ROS_INFO("recorder: writing %s (%d agents, %ld steps), monitor %s, %s, %s", path_.c_str(), n, lastStep_,
            monitor_.c_str(), maxMb > 0 ? ("at most " + std::to_string(static_cast<long>(maxMb)) + " MB").c_str() : "no size limit",
            splitMb > 0 ? ("files of " + std::to_string(static_cast<long>(splitMb)) + " MB").c_str() : "one file");
@@ -118,23 +118,11 @@ void RecorderNode::onBatch(std::size_t source, const ros::MessageEvent<variation
 }
 
 void RecorderNode::catchUp() {
-  // States published while a connection was coming up (an agent or the recorder restarted) are
-  // lost to this subscriber, but their agent still holds them: fetch them from its history.
-  if (progress_.state == RunProgress::FINISHED || progress_.state == RunProgress::FAILED) return;
-  if (progress_.completed_step != lastCatchUpStep_) {
-    lastCatchUpStep_ = progress_.completed_step;
-    stalledSince_ = ros::WallTime::now();
-    return;
-  }
-  if (secondsSince(stalledSince_) < 1.0) return;
+  const Protocol::Ready tick = protocol_->step(Protocol::Tick{ros::WallTime::now().toSec()});
+  if (!tick.catchUp) return;
+  const std::vector<int>& agents = tick.fetch;
   std::vector<std::string> services;
-  std::vector<int> agents;
-  for (int i = 0; i < states_.agentCount(); ++i) {
-    if (states_.statesBelow(i) <= progress_.completed_step + 1) {
-      agents.push_back(i);
-      services.push_back(owners_[static_cast<std::size_t>(i)] + "/history");
-    }
-  }
+  for (int i : agents) services.push_back(owners_[static_cast<std::size_t>(i)] + "/history");
   // Ask the agents, and the monitor, which keeps what it accepted until this recorder confirms
   // it (an agent that died again no longer holds its states).
   std::vector<RecallHistory> calls(2 * agents.size());
@@ -144,36 +132,50 @@ void RecorderNode::catchUp() {
     calls[agents.size() + k].request.id = agents[k];
   }
   const std::vector<bool> answered = callAllWithTimeout(services, calls, 2.0);
+  Protocol::HistoriesArrived held{0.0, {}};
   for (std::size_t c = 0; c < calls.size(); ++c) {
     if (!answered[c]) continue;
-    const int agent = agents[c % agents.size()];
-    for (const AgentState& s : calls[c].response.states) {
-      if (!states_.holdsState(agent, s.step)) record(agent, boost::make_shared<AgentState>(s));
-    }
+    held.answers.emplace_back(agents[c % agents.size()], std::vector<AgentState::ConstPtr>());
+    for (const AgentState& s : calls[c].response.states) held.answers.back().second.push_back(boost::make_shared<AgentState>(s));
   }
-  stalledSince_ = ros::WallTime::now();
+  held.now = ros::WallTime::now().toSec();
+  carryOut(protocol_->step(held));
 }
 
 void RecorderNode::record(int agent, const AgentState::ConstPtr& msg) {
-  RecordLedger::Arrival arrival = RecordLedger::Arrival::New;
-  try {
-    arrival = states_.addState(agent, msg->step, msg->position, msg->previous_position);
-  } catch (const InvalidInput& e) {
+  carryOut(protocol_->step(Protocol::StateArrived{agent, msg}));
+}
+
+void RecorderNode::carryOut(const Protocol::Ready& r) {
+  if (!r.dropped.empty()) {
     ++dropped_;
-    ROS_WARN_THROTTLE(1.0, "recorder: dropped a state of agent_%d: %s; %ld dropped so far", agent, e.what(), dropped_);
+    ROS_WARN_THROTTLE(1.0, "recorder: dropped %s; %ld dropped so far", r.dropped.c_str(), dropped_);
+  }
+  if (!r.failed.empty()) {
+    // It tells the monitor, which ends the run as failed, naming the reason.
+    progressPub_.publish(progressMessage(*r.report));
+    ROS_ERROR("recorder: %s", r.failed.c_str());
+    close(r.close);
+    exitStatus_ = r.exit;
     return;
   }
-  if (arrival == RecordLedger::Arrival::Differs) {
-    fail("agent_" + std::to_string(agent) + "'s step " + std::to_string(msg->step) +
-         " arrived twice with different positions: a recovery did not reproduce it bit for bit");
-    return;
+  for (const Protocol::Write& w : r.write) writeStep(w);
+  // Unless writing failed meanwhile; a finished recording is closed before the monitor hears it.
+  if (r.report && protocol_->progress().state != protocol::Progress::State::Failed) {
+    if (!r.close.empty()) close(r.close);
+    progressPub_.publish(progressMessage(*r.report));
   }
-  if (arrival != RecordLedger::Arrival::New) {
-    ++repeats_;  // already held (doc/distributed.md, recording)
-    uncompared_ += arrival == RecordLedger::Arrival::Unchecked;
-    return;
-  }
-  if (steps_->addState(agent, msg->step, msg)) flush();  // refused: cannot happen, a written step had all its states
+  if (!r.close.empty()) close(r.close);
+  if (r.exit >= 0) exitStatus_ = r.exit;
+}
+
+RunProgress RecorderNode::progressMessage(const protocol::Progress& p) const {
+  RunProgress m;
+  m.state = toMessage(p).state;
+  m.completed_step = p.completedStep;
+  m.reason = p.reason;
+  if (p.completedStep >= 0) m.header.stamp.fromSec(static_cast<double>(p.completedStep) * timeStep_);
+  return m;
 }
 
 bool RecorderNode::needsMarkers(long step) const {
@@ -183,7 +185,7 @@ bool RecorderNode::needsMarkers(long step) const {
 void RecorderNode::onStatus(const ros::MessageEvent<FormationStatus const>& event) {
   if (!fromOwner(event, monitor_)) return;
   const FormationStatus::ConstPtr msg = event.getConstMessage();
-  if (steps_->addStatus(msg->step, msg)) flush();  // refused if republished: written once
+  carryOut(protocol_->step(Protocol::StatusArrived{static_cast<long>(msg->step), msg}));
 }
 
 ros::Time RecorderNode::markersStamp(const visualization_msgs::MarkerArray& msg) {
@@ -194,45 +196,19 @@ void RecorderNode::onMarkers(const ros::MessageEvent<visualization_msgs::MarkerA
   if (!fromOwner(event, monitor_)) return;
   const auto msg = event.getConstMessage();
   const long step = protocol::stepOfStamp(markersStamp(*msg).toSec(), timeStep_);
-  if (steps_->addMarkers(step, msg)) flush();  // refused if republished: written once
+  carryOut(protocol_->step(Protocol::MarkersArrived{step, msg}));
 }
 
 void RecorderNode::onMonitorProgress(const ros::MessageEvent<RunProgress const>& event) {
   if (!fromOwner(event, monitor_)) return;
-  const RunProgress& p = *event.getConstMessage();
-  if (p.state == RunProgress::FINISHED || p.state == RunProgress::FAILED) {
-    close(p.state == RunProgress::FINISHED ? "finished" : "the run failed");
-    exitStatus_ = 0;
-  }
+  carryOut(protocol_->step(Protocol::MonitorProgress{agentProgressOf(*event.getConstMessage()).progress}));
 }
 
-void RecorderNode::report() {
-  if (progress_.state == RunProgress::FAILED || progress_.state == RunProgress::FINISHED) return;
-  // Complete up to k: every agent's state, the status and the markers of steps 0..k are written.
-  const long complete = steps_->handedOutThrough();
-  if (complete <= progress_.completed_step) return;
-  progress_.completed_step = complete;
-  progress_.header.stamp.fromSec(static_cast<double>(complete) * timeStep_);
-  progress_.state = RunProgress::RUNNING;
-  if (lastStep_ > 0 && complete >= lastStep_) {
-    close("complete");
-    progress_.state = RunProgress::FINISHED;
-  }
-  progressPub_.publish(progress_);
-}
-
-void RecorderNode::fail(const std::string& reason) {
-  progress_.state = RunProgress::FAILED;
-  progress_.reason = reason;
-  progressPub_.publish(progress_);
-  ROS_ERROR("recorder: %s", reason.c_str());
-  close("failed");
-  exitStatus_ = 1;
-}
+void RecorderNode::fail(const std::string& reason) { carryOut(protocol_->step(Protocol::Failure{reason})); }
 
 int RecorderNode::run() {
   auto* queue = ros::getGlobalCallbackQueue();
-  stalledSince_ = ros::WallTime::now();
+  protocol_->startClock(ros::WallTime::now().toSec());
   catchUpTimer_ = nh_.createWallTimer(ros::WallDuration(0.5), [this](const ros::WallTimerEvent&) { catchUp(); });
   while (ros::ok() && exitStatus_ < 0) queue->callAvailable(ros::WallDuration(0.1));
   close("interrupted");

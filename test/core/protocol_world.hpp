@@ -1,7 +1,7 @@
 #pragma once
-// A whole lockstep run without a transport, for the protocol tests: agents (LockstepAgent with
-// the histories and flow gate of AgentNode), the monitor's LockstepReferee and a recorder
-// (RecordLedger + StepAssembler), joined by a simulated network whose deliveries, repeats,
+// A whole lockstep run without a transport, for the protocol tests: the shipped agents
+// (AgentProtocol, as AgentNode runs it), the monitor's LockstepReferee and the shipped recorder
+// (RecorderProtocol, as RecorderNode runs it), joined by a simulated network whose deliveries, repeats,
 // reorderings, losses, kills and restarts a test chooses event by event.
 
 #include <algorithm>
@@ -16,10 +16,10 @@
 #include <vector>
 
 #include "variational_formation/core/lockstep_agent.hpp"
+#include "variational_formation/core/protocol/agent_protocol.hpp"
 #include "variational_formation/core/protocol/recovery.hpp"
 #include "variational_formation/core/protocol/run_referee.hpp"
-#include "variational_formation/core/protocol/step_assembler.hpp"
-#include "variational_formation/core/record_ledger.hpp"
+#include "variational_formation/core/protocol/recorder_protocol.hpp"
 #include "variational_formation/core/variational_integrator.hpp"
 
 namespace vf::test {
@@ -30,8 +30,11 @@ struct State {
   long step = -1;
   std::vector<double> position, previous_position;
 };
+using StatePtr = std::shared_ptr<const State>;
 using Referee = protocol::LockstepReferee<State, long>;
 using Progress = protocol::Progress;
+using AgentProtocol = protocol::AgentProtocol<StatePtr, Progress>;
+using Recorder = protocol::RecorderProtocol<StatePtr, long, long>;  // a status and markers are their step
 
 /// One message on its way. Kinds: a state (to a neighbour, the monitor or the recorder), a
 /// progress (to an agent or the recorder), a status or markers (to the recorder), a recorder
@@ -54,8 +57,7 @@ class World {
         formation_(makeFormation(s)),
         window_(window),
         markerEvery_(markerEvery),
-        ledger_(s.agentCount(), 1024),
-        assembler_(s.agentCount(), [this](long k) { return needsMarkers(k); }) {
+        recorder_(s.agentCount(), 1024, s.steps, [this](long k) { return needsMarkers(k); }, [](long) { return 0L; }) {
     VariationalIntegrator reference(formation_, s.initialPositions, s.initialVelocities, s.timeStep, s.dampingGain,
                                     StartMethod::Variational);
     expected_.push_back(reference.positions());
@@ -94,10 +96,10 @@ class World {
         }
         break;
       case Message::Kind::Status:
-        if (assembler_.addStatus(msg.step, msg.step)) writeWhole();
+        recorderDo(recorder_.step(Recorder::StatusArrived{msg.step, msg.step}));
         break;
       case Message::Kind::Markers:
-        if (assembler_.addMarkers(msg.step, msg.step)) writeWhole();
+        recorderDo(recorder_.step(Recorder::MarkersArrived{msg.step, msg.step}));
         break;
       case Message::Kind::RecorderProgress:
         if (monitor_) {
@@ -187,14 +189,14 @@ class World {
   bool finished() const { return finished_; }
   bool failed() const { return !failure_.empty(); }
   const std::string& failure() const { return failure_; }
-  long writtenThrough() const { return assembler_.handedOutThrough(); }
+  long writtenThrough() const { return recorder_.steps().handedOutThrough(); }
   long delivered() const { return delivered_; }
   long maxPendingSteps() const { return maxPending_; }
   /// The newest step any live agent computed.
   long newestAgentStep() const {
     long newest = -1;
     for (const auto& a : agents_) {
-      if (a) newest = std::max(newest, a->core.step());
+      if (a) newest = std::max(newest, a->agent().step());
     }
     return newest;
   }
@@ -202,13 +204,14 @@ class World {
   /// What each live participant waits for (the monitor's line, the recorder's oldest step).
   std::string waitingFor() const {
     std::string s = monitor_ ? "monitor: " + monitor_->waitingFor("recorder") : "monitor: dead";
-    s += "; recorder: " + assembler_.lacking();
+    s += "; recorder: " + recorder_.steps().lacking();
     if (std::getenv("PROTOCOL_TRACE")) {
       for (std::size_t i = 0; i < agents_.size(); ++i) {
-        const Agent* a = agents_[i].get();
-        s += "\n  agent " + std::to_string(i) + (a ? ": step " + std::to_string(a->core.step()) + " allowed " +
-                                                         std::to_string(a->allowed) + (a->core.ready() ? " ready" : "") +
-                                                         (a->over ? " over" : "") + " history " + std::to_string(a->history.size())
+        const AgentProtocol* a = agents_[i].get();
+        s += "\n  agent " + std::to_string(i) + (a ? ": step " + std::to_string(a->agent().step()) + " allowed " +
+                                                         std::to_string(a->allowedStep()) + (a->agent().ready() ? " ready" : "") +
+                                                         (a->exitStatus() >= 0 ? " over" : "") + " history " +
+                                                         std::to_string(a->history(a->agent().id())->size())
                                                    : ": dead");
       }
       if (monitor_) {
@@ -221,16 +224,14 @@ class World {
   }
 
  private:
-  struct Agent {
-    LockstepAgent core;
-    std::deque<State> history;
-    std::map<int, std::deque<State>> neighbourHistory;
-    long allowed = 0;
-    bool hasProgress = false;
-    Progress progress;
-    bool over = false;
-    Agent(const Scenario& s, int id) : core(s, id) {}
-  };
+  /// An agent's held states of agent j (its own or a neighbour's), oldest first.
+  static std::vector<State> held(const AgentProtocol& a, int j) {
+    std::vector<State> states;
+    if (const auto* h = a.history(j)) {
+      for (const StatePtr& s : *h) states.push_back(*s);
+    }
+    return states;
+  }
 
   static bool sameConnection(const Message& a, const Message& b) {
     return a.kind == b.kind && a.to == b.to && a.from == b.from;
@@ -242,34 +243,38 @@ class World {
     return m;
   }
   bool needsMarkers(long k) const { return k % markerEvery_ == 0 || (scenario_.steps > 0 && k == scenario_.steps); }
-  State stateOf(const LockstepAgent& a) const { return {a.id(), a.step(), a.position(), a.previousPosition()}; }
 
   void send(Message m) { inFlight_.push_back(std::move(m)); }
-  void publishState(int i) {
-    Agent& a = *agents_[static_cast<std::size_t>(i)];
-    const State s = stateOf(a.core);
-    a.history.push_back(s);
-    latched_[i] = s;
-    Message m{Message::Kind::State, 0, s, {}, -1, false, i};
-    for (int j : a.core.neighbourIds()) {
-      m.to = j;
+  /// Carries out what agent i's protocol said: its states go to its neighbours, the monitor and
+  /// the recorder, in order. No agent of these runs fails.
+  void carryOut(int i, const AgentProtocol::Ready& ready) {
+    if (!ready.failed.empty()) violations_.push_back("agent " + std::to_string(i) + " failed: " + ready.failed);
+    const AgentProtocol& a = *agents_[static_cast<std::size_t>(i)];
+    for (const StatePtr& s : ready.publish) {
+      latched_[i] = *s;
+      Message m{Message::Kind::State, 0, *s, {}, -1, false, i};
+      for (int j : a.agent().neighbourIds()) {
+        m.to = j;
+        send(m);
+      }
+      m.to = Message::Monitor;
+      send(m);
+      m.to = Message::Recorder;
       send(m);
     }
-    m.to = Message::Monitor;
-    send(m);
-    m.to = Message::Recorder;
-    send(m);
   }
   void startAgent(int i) {
-    auto a = std::make_unique<Agent>(scenario_, i);
+    auto a = std::make_unique<AgentProtocol>(LockstepAgent(scenario_, i), [](const LockstepAgent& c, const std::string&) {
+      return std::make_shared<const State>(State{c.id(), c.step(), c.position(), c.previousPosition()});
+    });
     std::vector<protocol::RecallAnswer> answers;
     std::vector<State> found;
-    for (int j : a->core.neighbourIds()) {
+    for (int j : a->agent().neighbourIds()) {
       protocol::RecallAnswer r;
       State s;
       r.answered = agents_[static_cast<std::size_t>(j)] != nullptr;
       if (r.answered) {
-        r.held = agents_[static_cast<std::size_t>(j)]->core.neighbourState(i, s.step, s.position, s.previous_position);
+        r.held = agents_[static_cast<std::size_t>(j)]->agent().neighbourState(i, s.step, s.position, s.previous_position);
         r.step = s.step;
       }
       answers.push_back(r);
@@ -286,47 +291,27 @@ class World {
     answers.push_back(r);
     found.push_back(s);
     const int k = protocol::chooseAgentResume(answers);
-    if (k >= 0) a->core.resume(found[static_cast<std::size_t>(k)].step, found[static_cast<std::size_t>(k)].position,
-                               found[static_cast<std::size_t>(k)].previous_position);
+    if (k >= 0) a->resume(found[static_cast<std::size_t>(k)].step, found[static_cast<std::size_t>(k)].position,
+                          found[static_cast<std::size_t>(k)].previous_position);
     agents_[static_cast<std::size_t>(i)] = std::move(a);
-    publishState(i);
+    carryOut(i, agents_[static_cast<std::size_t>(i)]->start());
     // Latched topics: the new subscriber gets each neighbour's newest state and the progress.
-    for (int j : agents_[static_cast<std::size_t>(i)]->core.neighbourIds()) {
+    for (int j : agents_[static_cast<std::size_t>(i)]->agent().neighbourIds()) {
       if (latched_.count(j)) send({Message::Kind::State, i, latched_[j], {}, -1, false, j});
     }
     if (latchedProgress_) send({Message::Kind::Progress, i, {}, *latchedProgress_, -1, false, -1});
   }
   void agentGotState(int i, const State& s) {
-    Agent* a = agents_[static_cast<std::size_t>(i)].get();
-    if (!a) return;
-    if (a->core.receive(s.id, s.step, s.position, s.previous_position) == LockstepAgent::Receipt::Accepted) {
-      a->neighbourHistory[s.id].push_back(s);
-      advance(i);
+    if (AgentProtocol* a = agents_[static_cast<std::size_t>(i)].get()) {
+      carryOut(i, a->step(AgentProtocol::StateArrived{s.id, std::make_shared<const State>(s)}));
     }
   }
   void agentGotProgress(int i, const Progress& p) {
-    Agent* a = agents_[static_cast<std::size_t>(i)].get();
-    if (!a) return;
-    if (!a->hasProgress || p.completedStep >= a->progress.completedStep) {
-      a->progress = p;
-      a->hasProgress = true;
-      while (!a->history.empty() && a->history.front().step <= p.completedStep) a->history.pop_front();
-      for (auto& held : a->neighbourHistory) {
-        while (!held.second.empty() && held.second.front().step <= p.completedStep) held.second.pop_front();
-      }
-    }
-    if (p.state == Progress::State::Finished || p.state == Progress::State::Failed) {
-      a->over = true;
-    } else {
-      a->allowed = std::max(a->allowed, p.allowedStep);
-      advance(i);
-    }
-  }
-  void advance(int i) {
-    Agent& a = *agents_[static_cast<std::size_t>(i)];
-    while (!a.over && !a.core.finished() && a.core.step() < a.allowed && a.core.ready()) {
-      a.core.advance();
-      publishState(i);
+    if (AgentProtocol* a = agents_[static_cast<std::size_t>(i)].get()) {
+      AgentProtocol::ProgressArrived heard;  // no commands in these runs
+      heard.progress.progress = p;
+      heard.message = p;
+      carryOut(i, a->step(heard));
     }
   }
 
@@ -336,8 +321,9 @@ class World {
     std::vector<std::vector<State>> histories(agents_.size());
     for (std::size_t i = 0; i < agents_.size(); ++i) {
       if (!agents_[i]) continue;
-      answers[i] = {true, agents_[i]->hasProgress, agents_[i]->progress.completedStep, agents_[i]->progress.convergedStep};
-      histories[i].assign(agents_[i]->history.begin(), agents_[i]->history.end());
+      const Progress& heard = agents_[i]->lastProgress();
+      answers[i] = {true, agents_[i]->hasProgress(), heard.completedStep, heard.convergedStep};
+      histories[i] = held(*agents_[i], static_cast<int>(i));
     }
     monitor_->resume(answers, histories);
     // Latched: the agents' newest states and the recorder's progress reach the new subscriber.
@@ -368,7 +354,7 @@ class World {
     if (std::getenv("PROTOCOL_TRACE")) {
       std::string line = what + " | monitor " + (monitor_ ? std::to_string(monitor_->completedStep()) : "dead") + " written " +
                          std::to_string(written_) + " agents";
-      for (const auto& a : agents_) line += " " + (a ? std::to_string(a->core.step()) + "/" + std::to_string(a->progress.completedStep) : "x");
+      for (const auto& a : agents_) line += " " + (a ? std::to_string(a->agent().step()) + "/" + std::to_string(a->lastProgress().completedStep) : "x");
       std::fprintf(stderr, "%s\n", line.c_str());
     }
   }
@@ -382,17 +368,12 @@ class World {
     const std::vector<int> missing = monitor_->missing();
     if (monitor_->running() && !missing.empty()) {
       for (int i : missing) {
-        if (agents_[static_cast<std::size_t>(i)]) {
-          const auto& h = agents_[static_cast<std::size_t>(i)]->history;
-          monitor_->offerHistory(i, std::vector<State>(h.begin(), h.end()));
-        }
+        if (agents_[static_cast<std::size_t>(i)]) monitor_->offerHistory(i, held(*agents_[static_cast<std::size_t>(i)], i));
       }
       for (int i : monitor_->missing()) {
         for (const Neighbour& j : formation_.neighbours(i)) {
-          const Agent* a = agents_[static_cast<std::size_t>(j.agent)].get();
-          if (!a) continue;
-          const auto it = a->neighbourHistory.find(i);
-          if (it != a->neighbourHistory.end()) monitor_->offerHistory(i, std::vector<State>(it->second.begin(), it->second.end()));
+          const AgentProtocol* a = agents_[static_cast<std::size_t>(j.agent)].get();
+          if (a && a->history(i)) monitor_->offerHistory(i, held(*a, i));
         }
       }
     }
@@ -405,64 +386,71 @@ class World {
     monitorUpdate();
   }
 
-  void record(int i, const State& s) {
-    const auto arrival = ledger_.addState(i, s.step, s.position, s.previous_position);
-    if (arrival == RecordLedger::Arrival::Differs) violations_.push_back("a repeat differs from the first copy");
-    if (arrival != RecordLedger::Arrival::New) return;
-    const auto& q = expected_[static_cast<std::size_t>(s.step)];
-    const auto& qPrev = expected_[static_cast<std::size_t>(std::max(0L, s.step - 1))];
-    for (int c = 0; c < scenario_.dimension; ++c) {
-      if (s.position[static_cast<std::size_t>(c)] != q(c, i) ||
-          (s.step > 0 && s.previous_position[static_cast<std::size_t>(c)] != qPrev(c, i))) {
-        violations_.push_back("agent " + std::to_string(i) + "'s step " + std::to_string(s.step) +
-                              " differs from the centralised run");
-        break;
+  void record(int i, const State& s) { recorderDo(recorder_.step(Recorder::StateArrived{i, std::make_shared<const State>(s)})); }
+  /// Carries out what the recorder said: each written step is checked (in order, whole, every
+  /// state equal to the centralised run) and its progress goes to the monitor.
+  void recorderDo(const Recorder::Ready& r) {
+    if (!r.failed.empty()) violations_.push_back("the recorder failed: " + r.failed);
+    if (recorder_.refused() > 0) violations_.push_back("a new state of a written step");
+    maxPending_ = std::max(maxPending_, static_cast<long>(recorder_.steps().pendingSteps() + r.write.size()));
+    for (const Recorder::Write& w : r.write) {
+      if (w.step.step != written_ + 1) violations_.push_back("step " + std::to_string(w.step.step) + " written out of order");
+      written_ = w.step.step;
+      const auto& q = expected_[static_cast<std::size_t>(w.step.step)];
+      const auto& qPrev = expected_[static_cast<std::size_t>(std::max(0L, w.step.step - 1))];
+      for (int i = 0; i < agentCount(); ++i) {
+        const State& st = *w.step.states[static_cast<std::size_t>(i)];
+        for (int c = 0; c < scenario_.dimension; ++c) {
+          if (st.step != w.step.step || st.position[static_cast<std::size_t>(c)] != q(c, i) ||
+              (st.step > 0 && st.previous_position[static_cast<std::size_t>(c)] != qPrev(c, i))) {
+            violations_.push_back("agent " + std::to_string(i) + "'s step " + std::to_string(w.step.step) +
+                                  " differs from the centralised run");
+            break;
+          }
+        }
       }
     }
-    if (!assembler_.addState(i, s.step, s.step)) violations_.push_back("a new state of a written step");
-    writeWhole();
-  }
-  void writeWhole() {
-    maxPending_ = std::max(maxPending_, static_cast<long>(assembler_.pendingSteps()));
-    for (const auto& whole : assembler_.takeWhole()) {
-      if (whole.step != written_ + 1) violations_.push_back("step " + std::to_string(whole.step) + " written out of order");
-      written_ = whole.step;
-    }
-    if (written_ > recorderReported_) {
-      recorderReported_ = written_;
-      recorderFinished_ = scenario_.steps > 0 && written_ >= scenario_.steps;
-      send({Message::Kind::RecorderProgress, Message::Monitor, {}, {}, written_, recorderFinished_, -1});
+    if (r.report) {
+      recorderReported_ = r.report->completedStep;
+      recorderFinished_ = r.report->state == Progress::State::Finished;
+      send({Message::Kind::RecorderProgress, Message::Monitor, {}, {}, recorderReported_, recorderFinished_, -1});
     }
   }
   void recorderGotProgress(const Progress& p) {
-    recorderProgress_ = std::max(recorderProgress_, p.completedStep);
     if (p.state == Progress::State::Failed) failure_ = p.reason;
+    recorderDo(recorder_.step(Recorder::MonitorProgress{p}));
   }
+  /// The recorder's catch-up timer (a second of its clock per call): the histories of the agents
+  /// and the monitor, as the node fetches them.
   void recorderCatchUp() {
-    for (int i = 0; i < agentCount(); ++i) {
-      if (ledger_.statesBelow(i) > written_ + 1) continue;  // it holds its part of the next step
-      std::vector<State> held;
-      if (agents_[static_cast<std::size_t>(i)]) {
-        held.assign(agents_[static_cast<std::size_t>(i)]->history.begin(), agents_[static_cast<std::size_t>(i)]->history.end());
-      }
-      if (monitor_) held.insert(held.end(), monitor_->unrecordedStates(i).begin(), monitor_->unrecordedStates(i).end());
-      for (const State& s : held) {
-        if (!ledger_.holdsState(i, s.step)) record(i, s);
+    recorderClock_ += 1.0;
+    const Recorder::Ready tick = recorder_.step(Recorder::Tick{recorderClock_});
+    if (!tick.catchUp) return;
+    Recorder::HistoriesArrived answers{recorderClock_, {}};
+    for (int i : tick.fetch) {
+      if (const AgentProtocol* a = agents_[static_cast<std::size_t>(i)].get()) {
+        answers.answers.emplace_back(i, std::vector<StatePtr>(a->history(i)->begin(), a->history(i)->end()));
       }
     }
+    for (int i : tick.fetch) {
+      if (!monitor_) continue;
+      answers.answers.emplace_back(i, std::vector<StatePtr>());
+      for (const State& st : monitor_->unrecordedStates(i)) answers.answers.back().second.push_back(std::make_shared<const State>(st));
+    }
+    recorderDo(recorder_.step(answers));
   }
 
   Scenario scenario_;
   Formation formation_;
   long window_, markerEvery_;
   std::vector<Positions> expected_;
-  std::vector<std::unique_ptr<Agent>> agents_;
+  std::vector<std::unique_ptr<AgentProtocol>> agents_;
   std::map<int, State> latched_;  // each agent's newest published state
   std::optional<Progress> latchedProgress_;
   std::unique_ptr<Referee> monitor_;
-  RecordLedger ledger_;
-  protocol::StepAssembler<long, long, long> assembler_;
-  long latchedStatus_ = -1, written_ = -1, recorderReported_ = -1, recorderProgress_ = -1, maxPending_ = 0, delivered_ = 0;
+  Recorder recorder_;
+  double recorderClock_ = 0.0;
+  long latchedStatus_ = -1, written_ = -1, recorderReported_ = -1, maxPending_ = 0, delivered_ = 0;
   bool recorderFinished_ = false, finished_ = false;
   std::string failure_;
   std::vector<Message> inFlight_;

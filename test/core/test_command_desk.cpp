@@ -3,17 +3,19 @@
 // lockstep protocol with commands arriving at random moments, lists and progress delivered late
 // (in order, per topic), agents killed and resumed, and the monitor restarted from the agents'
 // lists, and checks every agent's every step against ManoeuvreIntegrator on the applied schedule,
-// bit for bit. A failing seed is printed.
+// bit for bit. The agents are the shipped protocol::AgentProtocol. A failing seed is printed.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <deque>
+#include <memory>
 #include <random>
 
 #include "test_support.hpp"
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/lockstep_agent.hpp"
 #include "variational_formation/core/manoeuvre_integrator.hpp"
+#include "variational_formation/core/protocol/agent_protocol.hpp"
 #include "variational_formation/core/protocol/command_desk.hpp"
 
 namespace vf {
@@ -182,16 +184,27 @@ TEST(CommandDesk, RefusesAScaleBeyondTheStabilityLimitAndBadLimits) {
   }
 }
 
-// The lockstep protocol with live commands, driven by one seed (see the file comment).
+// The lockstep protocol with live commands, driven by one seed (see the file comment): the
+// shipped agents (protocol::AgentProtocol, as AgentNode runs it) and a CommandDesk as the
+// monitor's, joined by per-agent topics that deliver late, each in order.
 struct CommandWorld {
+  struct State {
+    int id;
+    long step;
+    std::vector<double> position, previous_position;
+  };
+  using StatePtr = std::shared_ptr<const State>;
+  using Agent = protocol::AgentProtocol<StatePtr, protocol::AgentProgress>;
+
   Scenario s;
   std::mt19937 rng;
   long window;
-  std::vector<LockstepAgent> agents;
-  std::vector<std::size_t> applied;     // how many listed commands each agent has applied
-  std::vector<long> allowedSeen, countSeen;
-  // Per agent, what the topics still have to deliver, in order: (allowed step, command count)
-  // progress messages, and whole lists.
+  std::vector<std::unique_ptr<Agent>> agents;
+  std::vector<StatePtr> latched;  // each agent's newest published state
+  std::vector<std::vector<std::vector<double>>> computed;  // each agent's q_k, by step
+  // Per agent, what the topics still have to deliver, in order: its neighbours' states,
+  // (allowed step, command count) progress messages, and whole lists.
+  std::vector<std::deque<StatePtr>> statesInFlight;
   std::vector<std::deque<std::pair<long, long>>> progressInFlight;
   std::vector<std::deque<std::vector<IssuedCommand>>> listsInFlight;
   std::unique_ptr<CommandDesk> desk;
@@ -200,15 +213,38 @@ struct CommandWorld {
   CommandWorld(Scenario scenario, unsigned seed, long w) : s(std::move(scenario)), rng(seed), window(w) {
     desk = std::make_unique<CommandDesk>(s);
     const auto n = static_cast<std::size_t>(s.agentCount());
-    for (int i = 0; i < s.agentCount(); ++i) agents.emplace_back(s, i);
-    applied.assign(n, 0);
-    allowedSeen.assign(n, 0);
-    countSeen.assign(n, 0);
+    agents.resize(n);
+    latched.resize(n);
+    computed.resize(n);
+    statesInFlight.resize(n);
     progressInFlight.resize(n);
     listsInFlight.resize(n);
+    for (int i = 0; i < s.agentCount(); ++i) {
+      agents[static_cast<std::size_t>(i)] = makeAgent(i);
+      carryOut(static_cast<std::size_t>(i), agents[static_cast<std::size_t>(i)]->start());
+    }
+  }
+  std::unique_ptr<Agent> makeAgent(int i) const {
+    return std::make_unique<Agent>(LockstepAgent(s, i), [](const LockstepAgent& a, const std::string&) {
+      return std::make_shared<const State>(State{a.id(), a.step(), a.position(), a.previousPosition()});
+    });
   }
   bool chance(double p) { return std::uniform_real_distribution<double>(0.0, 1.0)(rng) < p; }
   double uniform(double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); }
+
+  // What agent i's protocol said: each new state is checked against the same step computed
+  // before (a resumed agent recomputes it) and goes to its neighbours.
+  void carryOut(std::size_t i, const Agent::Ready& ready) {
+    ASSERT_EQ(ready.failed, "") << "agent " << i;
+    for (const StatePtr& state : ready.publish) {
+      auto& q = computed[i];
+      if (static_cast<long>(q.size()) == state->step) q.push_back(state->position);
+      ASSERT_EQ(q[static_cast<std::size_t>(state->step)], state->position) << "agent " << i << " redid step "
+                                                                            << state->step << " differently";
+      latched[i] = state;
+      for (int j : agents[i]->agent().neighbourIds()) statesInFlight[static_cast<std::size_t>(j)].push_back(state);
+    }
+  }
 
   // The monitor: what it publishes, list first, then the progress that counts it.
   void publish() {
@@ -217,7 +253,7 @@ struct CommandWorld {
   }
   long completed() const {
     long c = s.steps;
-    for (const auto& a : agents) c = std::min(c, a.step());
+    for (const auto& a : agents) c = std::min(c, a->agent().step());
     return c;
   }
   void monitorTick() {
@@ -244,35 +280,41 @@ struct CommandWorld {
     publish();
   }
   void deliver(std::size_t i) {
+    Agent& a = *agents[i];
     while (!listsInFlight[i].empty() && chance(0.6)) {
       const std::vector<IssuedCommand> list = listsInFlight[i].front();
       listsInFlight[i].pop_front();
-      for (; applied[i] < list.size(); ++applied[i]) {
-        const IssuedCommand& c = list[applied[i]];
-        ASSERT_EQ(agents[i].receiveCommand(c.first, c.second), LockstepAgent::CommandReceipt::Accepted)
-            << "agent " << i << " at step " << agents[i].step() << ", command at " << c.first;
-      }
+      carryOut(i, a.step(Agent::CommandsArrived{static_cast<long>(list.size()),
+                                                [&list](long k) { return list[static_cast<std::size_t>(k)]; }}));
+      if (::testing::Test::HasFatalFailure()) return;
     }
     while (!progressInFlight[i].empty() && chance(0.6)) {
-      allowedSeen[i] = std::max(allowedSeen[i], progressInFlight[i].front().first);
-      // The newest progress's count, not the largest: a restarted monitor may count fewer (a
-      // command the monitor before it issued, which no agent received, is gone with it).
-      countSeen[i] = progressInFlight[i].front().second;
+      protocol::AgentProgress p;
+      p.progress.state = protocol::Progress::State::Running;
+      p.progress.allowedStep = progressInFlight[i].front().first;
+      // A restarted monitor may count fewer (a command the monitor before it issued, which no
+      // agent received, is gone with it): the newest progress's count holds.
+      p.commands = progressInFlight[i].front().second;
       progressInFlight[i].pop_front();
+      carryOut(i, a.step(Agent::ProgressArrived{p, p}));
+      if (::testing::Test::HasFatalFailure()) return;
+    }
+    while (!statesInFlight[i].empty() && chance(0.7)) {
+      const StatePtr state = statesInFlight[i].front();
+      statesInFlight[i].pop_front();
+      carryOut(i, a.step(Agent::StateArrived{state->id, state}));
+      if (::testing::Test::HasFatalFailure()) return;
     }
   }
   // An agent killed and resumed from its own newest state, with no command and no progress: the
-  // latched topics give it the newest list and progress again.
+  // latched topics give it its neighbours' newest states, the newest list and progress again.
   void kill(std::size_t i) {
-    const long step = agents[i].step();
-    const std::vector<double> q = agents[i].position(), qPrev = agents[i].previousPosition();
-    agents[i] = LockstepAgent(s, static_cast<int>(i));
-    agents[i].resume(step, q, qPrev);
-    for (const auto& a : agents) {
-      if (a.id() != static_cast<int>(i)) agents[i].receive(a.id(), a.step(), a.position(), a.previousPosition());
-    }
-    applied[i] = 0;
-    allowedSeen[i] = countSeen[i] = 0;
+    const StatePtr own = latched[i];
+    agents[i] = makeAgent(static_cast<int>(i));
+    agents[i]->resume(own->step, own->position, own->previous_position);
+    carryOut(i, agents[i]->start());
+    statesInFlight[i].clear();
+    for (int j : agents[i]->agent().neighbourIds()) statesInFlight[i].push_back(latched[static_cast<std::size_t>(j)]);
     progressInFlight[i].assign(1, {allowed, static_cast<long>(desk->issued().size())});
     listsInFlight[i].assign(1, desk->issued());
   }
@@ -281,29 +323,14 @@ struct CommandWorld {
 void runCommandWorld(const Scenario& scenario, unsigned seed, long window, bool faults) {
   SCOPED_TRACE("seed " + std::to_string(seed) + " (test_command_desk --gtest_filter=*Random*)");
   CommandWorld w(scenario, seed, window);
-  std::vector<std::vector<std::vector<double>>> computed(w.agents.size());
-  for (std::size_t i = 0; i < w.agents.size(); ++i) computed[i].push_back(w.agents[i].position());
-  for (auto& a : w.agents) {  // every agent's state at step 0
-    for (const auto& b : w.agents) a.receive(b.id(), b.step(), b.position(), b.previousPosition());
-  }
   w.publish();
   for (long tick = 0; tick < 200000 && w.completed() < w.s.steps; ++tick) {
     w.monitorTick();
     if (faults && w.chance(0.002)) w.restartMonitor();
     for (std::size_t i = 0; i < w.agents.size(); ++i) {
       w.deliver(i);
-      if (::testing::Test::HasFatalFailure()) return;
       if (faults && w.chance(0.003)) w.kill(i);
-      LockstepAgent& a = w.agents[i];
-      // The gate: within the allowed step, with every neighbour's state and every counted command.
-      if (!a.finished() && a.step() < w.allowedSeen[i] && a.ready() &&
-          static_cast<long>(w.applied[i]) >= w.countSeen[i] && w.chance(0.7)) {
-        a.advance();
-        if (static_cast<long>(computed[i].size()) == a.step()) computed[i].push_back(a.position());
-        ASSERT_EQ(computed[i][static_cast<std::size_t>(a.step())], a.position()) << "agent " << i << " redid step "
-                                                                                 << a.step() << " differently";
-        for (auto& b : w.agents) b.receive(a.id(), a.step(), a.position(), a.previousPosition());
-      }
+      if (::testing::Test::HasFatalFailure()) return;
     }
   }
   ASSERT_EQ(w.completed(), w.s.steps) << "the run stalled at step " << w.completed();
@@ -315,7 +342,7 @@ void runCommandWorld(const Scenario& scenario, unsigned seed, long window, bool 
     reference.step();
     for (std::size_t i = 0; i < w.agents.size(); ++i) {
       for (int c = 0; c < w.s.dimension; ++c) {
-        ASSERT_EQ(computed[i][static_cast<std::size_t>(k)][static_cast<std::size_t>(c)],
+        ASSERT_EQ(w.computed[i][static_cast<std::size_t>(k)][static_cast<std::size_t>(c)],
                   reference.positions()(c, static_cast<long>(i)))
             << "agent " << i << " step " << k << "; " << w.desk->issued().size() << " commands issued";
       }

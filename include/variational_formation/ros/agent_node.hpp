@@ -7,8 +7,6 @@
 #include <ros/ros.h>
 #include <tf2_ros/transform_broadcaster.h>
 
-#include <deque>
-
 #include "variational_formation/AgentState.h"
 #include "variational_formation/FormationCommands.h"
 #include "variational_formation/RecallHistory.h"
@@ -17,6 +15,7 @@
 #include "variational_formation/ros/periodic_call.hpp"
 #include "variational_formation/ros/participants.hpp"
 #include "variational_formation/core/lockstep_agent.hpp"
+#include "variational_formation/core/protocol/agent_protocol.hpp"
 
 namespace vf {
 
@@ -27,9 +26,10 @@ using variational_formation::RecallState;
 using variational_formation::RunProgress;
 
 /**
- * ROS I/O of one agent in lockstep mode (doc/distributed.md). Event-driven: every callback ends
- * in tryAdvance(), which computes as many steps as the neighbours' states, the monitor's
- * allowed step and the pacing permit. All maths is LockstepAgent's.
+ * ROS I/O of one agent in lockstep mode (doc/distributed.md). Event-driven: every callback hands
+ * its message to protocol::AgentProtocol and carries out the Ready it returns (publish, log, a
+ * pacing timer, a wake-up from the board): the gates, histories and failures are the protocol's,
+ * all maths is LockstepAgent's.
  *
  * On start it asks its neighbours and the monitor for the newest state of its own they hold, and
  * resumes from the highest step found (crash recovery; at step 0, or when nobody holds anything,
@@ -71,52 +71,45 @@ class AgentNode {
   int run();
 
  private:
+  using Protocol = protocol::AgentProtocol<AgentState::ConstPtr, RunProgress>;
+
   void onNeighbourState(int neighbour, const ros::MessageEvent<AgentState const>& event);
-  /// With a shared board: tryAdvance() on this agent's queue once the board holds step k.
+  /// With a shared board: a Wake on this agent's queue once the board holds step k.
   void wakeWhenSensed();
   /// Whose states it subscribes to: its neighbours, and with an own board every other agent.
   std::vector<int> sources() const;
   void onProgress(const ros::MessageEvent<RunProgress const>& event);
-  /// The monitor's list of issued commands (src/ros/agent_commands.cpp): applies the new ones.
+  /// The monitor's list of issued commands (src/ros/agent_commands.cpp).
   void onCommands(const ros::MessageEvent<variational_formation::FormationCommands const>& event);
-  void tryAdvance();
-  /// tryAdvance() again in `wait` seconds, released by the process's Pacer (once per step).
+  /// Does what the protocol said, in its order.
+  void carryOut(const Protocol::Ready& ready);
+  /// A Wake for the protocol in `wait` seconds, released by the process's Pacer (once per step).
   void paceFor(double wait);
-  void publish();
+  /// The state message of the agent's current step (the protocol's MakeState).
+  AgentState::ConstPtr makeState(const LockstepAgent& agent, const std::string& failure) const;
+  void publish(const AgentState::ConstPtr& state);
   void reportWaiting();
-  std::string waitingFor() const;
   void drop(const std::string& why);
   void resume(const Recovery& recovery);
   bool onRecall(RecallState::Request& request, RecallState::Response& response);
   bool onHistory(RecallHistory::Request& request, RecallHistory::Response& response);
+  const LockstepAgent& agent() const { return protocol_->agent(); }
 
   ros::NodeHandle nh_;
-  std::unique_ptr<LockstepAgent> agent_;
+  std::unique_ptr<Protocol> protocol_;
   ros::Publisher statePub_;
   std::vector<ros::Subscriber> subs_;
   std::vector<std::string> owners_;           // full node names, by agent id
   std::vector<std::string> managers_;         // ~agent_manager: nodelet managers of agents
   ros::Subscriber progressSub_, commandSub_;
-  long commandsHeld_ = 0;     // commands of the monitor's list applied
-  long commandsCounted_ = 0;  // commands the newest progress counts: the agent steps only once it holds them
   ros::ServiceServer recallServer_, historyServer_;
-  std::deque<AgentState::ConstPtr> history_;  // published states after the last completed step
-  // Neighbours' states accepted after the last completed step, indexed like neighbourIds(): a
-  // state of an incarnation that died may exist nowhere else (doc/distributed.md, recovery).
-  std::vector<std::deque<AgentState::ConstPtr>> neighbourHistory_;
-  RunProgress lastProgress_;
-  bool hasProgress_ = false;
-  long startStep_ = 0;
   std::string monitor_;
   tf2_ros::TransformBroadcaster tf_;
   long pacedStep_ = -1;  // the step whose release by the Pacer it waits for (-1: none)
   double realTimeFactor_ = 0.0;
-  long allowedStep_ = 0;
-  bool started_ = false;
-  ros::WallTime startedAt_, lastStepAt_, lastReportAt_;
+  ros::WallTime lastReportAt_;
   long dropped_ = 0;
-  int exitStatus_ = -1;  // -1: running
-  std::string name_, frame_, failure_, worldFrame_;
+  std::string name_, frame_, worldFrame_;
   bool sharedBoard_ = false;  // the manager's board (SensingHub), not one of its own
   long wakeStep_ = -1;        // the step a wake-up from the board is asked for
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);  // read by queued wake-ups

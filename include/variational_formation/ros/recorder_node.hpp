@@ -14,8 +14,7 @@
 #include "variational_formation/FormationStatus.h"
 #include "variational_formation/RecallHistory.h"
 #include "variational_formation/RunProgress.h"
-#include "variational_formation/core/protocol/step_assembler.hpp"
-#include "variational_formation/core/record_ledger.hpp"
+#include "variational_formation/core/protocol/recorder_protocol.hpp"
 #include "variational_formation/core/scenario.hpp"
 
 namespace vf {
@@ -40,9 +39,10 @@ using variational_formation::RunProgress;
  * together reach it; the run goes on and the recorder keeps counting steps, so it never holds
  * the agents back afterwards.
  *
- * Steps are written whole and in order (states with their transforms, status, markers), once all
- * of step k has arrived and after step k - 1, so the bag is in time order however late a state
- * came. The bag holds each (agent, step) state, each status and each step's markers once: a copy that
+ * What to write when, what to report and when to catch up is protocol::RecorderProtocol's; the
+ * node moves messages to it and writes what it says. Steps are written whole and in order
+ * (states with their transforms, status, markers), once all of step k has arrived and after
+ * step k - 1, so the bag is in time order however late a state came. The bag holds each (agent, step) state, each status and each step's markers once: a copy that
  * arrives again (from a history fetched while the topic was still delivering it, or from an
  * agent that republishes after a restart) is not written, and a repeated state that differs
  * from the written one, bit for bit, fails the run (RecordLedger).
@@ -56,25 +56,29 @@ class RecorderNode {
   int run();
 
  private:
+  using Protocol = protocol::RecorderProtocol<AgentState::ConstPtr, FormationStatus::ConstPtr,
+                                              visualization_msgs::MarkerArray::ConstPtr>;
   template <typename M>
   void write(const std::string& topic, const M& msg, const ros::Time& stamp);
   void onState(int agent, const ros::MessageEvent<AgentState const>& event);
   /// A manager's batch of its agents' states (doc/distributed.md, "Batches").
   void onBatch(std::size_t source, const ros::MessageEvent<variational_formation::AgentStates const>& event);
-  /// A state from the owner's topic or a fetched history: held until its step is written.
+  /// A state from the owner's topic: to the protocol.
   void record(int agent, const AgentState::ConstPtr& msg);
-  using Steps = protocol::StepAssembler<AgentState::ConstPtr, FormationStatus::ConstPtr,
-                                        visualization_msgs::MarkerArray::ConstPtr>;
-  /// Writes every complete step after writtenThrough_, in order, then reports.
-  void flush();
+  /// Does what the protocol said, in its order.
+  void carryOut(const Protocol::Ready& ready);
+  /// Writes one whole step (and the commands that apply from it) to the bag.
+  void writeStep(const Protocol::Write& w);
+  /// The recorder's progress as a message (stamped with the simulated time of its completed step).
+  RunProgress progressMessage(const protocol::Progress& p) const;
   /// The monitor publishes the markers of every marker_every-th step and of the last one.
   bool needsMarkers(long step) const;
   static ros::Time markersStamp(const visualization_msgs::MarkerArray& msg);
+  /// Asks the protocol whether to catch up, and fetches the histories it names.
   void catchUp();
   void onStatus(const ros::MessageEvent<FormationStatus const>& event);
   void onMarkers(const ros::MessageEvent<visualization_msgs::MarkerArray const>& event);
   void onMonitorProgress(const ros::MessageEvent<RunProgress const>& event);
-  void report();
   void close(const std::string& how);
   /// Ends the recording and tells the monitor, which ends the run as failed, naming the reason.
   void fail(const std::string& reason);
@@ -83,9 +87,9 @@ class RecorderNode {
   // Live commands (src/ros/recorder_commands.cpp).
   void setUpCommands(ros::NodeHandle& nh, ros::NodeHandle& pnh);
   void onCommands(const ros::MessageEvent<variational_formation::FormationCommands const>& event);
-  /// Writes the commands that apply from `step` on (or earlier) and are not in the bag yet, as the
-  /// list so far, at t_step: just before the step's states.
-  void writeCommandsUpTo(long step);
+  /// Writes the first `count` listed commands, as the list so far, at t_step: just before the
+  /// step's states.
+  void writeListedCommands(std::size_t count, long step);
   /// The whole schedule the agents apply, as a `simulate --commands` file (~commands_file).
   void writeCommandsFile() const;
 
@@ -95,22 +99,18 @@ class RecorderNode {
   std::vector<std::string> stateTopics_, frameIds_;  // by agent
   std::vector<ros::Subscriber> subs_;
   ros::Publisher progressPub_;
-  RunProgress progress_;
   long lastStep_ = 0;  // the scenario's steps (0: unbounded)
   double timeStep_ = 0.0;
   std::vector<std::string> owners_;
   std::vector<std::string> managers_;  // ~agent_manager: nodelet managers of agents
   std::vector<BatchSource> batches_;    // those of them whose agents come batched
-  RecordLedger states_;  // each state is held once; repeats are compared with it
-  /// Steps not yet written (at most protocol::recorderLead of them); every stream of the steps it
-  /// handed out is in the bag (or past its size limit).
-  std::unique_ptr<Steps> steps_;
+  /// Steps not yet written (at most protocol::recorderLead of them) and the states held; every
+  /// stream of the steps it handed out is in the bag (or past its size limit).
+  std::unique_ptr<Protocol> protocol_;
   long markerEvery_ = 1;
-  long written_ = 0, repeats_ = 0, uncompared_ = 0, dropped_ = 0;
+  long written_ = 0, dropped_ = 0;
   bool open_ = false;
   ros::WallTimer catchUpTimer_;
-  ros::WallTime stalledSince_;
-  long lastCatchUpStep_ = -2;
   bool limited_ = false;  // the size limit ended the recording
   double splitBytes_ = 0.0, maxBytes_ = 0.0, closedBytes_ = 0.0;
   int part_ = 0;
@@ -118,7 +118,6 @@ class RecorderNode {
   Scenario scenario_;
   std::string commandsFile_;  // ~commands_file ("" : none)
   variational_formation::FormationCommands commands_;  // the monitor's newest list
-  std::size_t commandsInBag_ = 0;
 };
 
 }  // namespace vf

@@ -10,19 +10,10 @@
 
 #include "variational_formation/core/error.hpp"
 #include "variational_formation/core/monitor.hpp"
+#include "variational_formation/core/protocol/progress.hpp"
 #include "variational_formation/core/protocol/recovery.hpp"
 
 namespace vf::protocol {
-
-/// The run's flow state as the monitor publishes it (`progress`, RunProgress.msg).
-struct Progress {
-  enum class State { Waiting, Running, Finished, Failed };
-  State state = State::Waiting;
-  long completedStep = -1;  ///< every step up to here is complete (and recorded, if recording)
-  long allowedStep = 0;     ///< agents may compute up to this step
-  long convergedStep = -1;  ///< first step of the congruent stretch holding at completedStep
-  std::string reason;       ///< why it failed
-};
 
 /**
  * The referee of a lockstep run without a transport (doc/distributed.md): the monitor's side of
