@@ -1,31 +1,71 @@
 #!/usr/bin/env bash
 # README's throughput table in one run: for each agent count, scripts/benchmark_ros.sh with
-# nodelets (ring with chords, h = 0.005, no recording) next to the transport's ceiling for the same
+# nodelets (ring with chords, h = 0.005 s, no recording) next to the transport's ceiling for the same
 # pattern (benchmark_transport: agents in one process, the monitor's part in another over TCP,
-# reading one batch per step), and their ratio. Prints a Markdown table.
+# reading one batch per step). Prints a Markdown table, then each target of issue 34 with its
+# ratio and pass or fail. Columns:
+#   steps/s: the lockstep run's; agent-steps/s: steps/s x agents; µs per agent-step: its inverse
+#   (wall time, the machine's 2 cores shared by the manager and the monitor);
+#   ratio to R: agent-steps/s over the same at the reference count R (100 if listed, else the
+#   first count): 1 is a flat per-agent cost;
+#   ceiling, steps/s and its ratio to R (the ceiling's own flatness: it must be linear too);
+#   lockstep / ceiling.
+# Targets: agent-steps/s at 200 >= 0.8 x at 100 and at 1000 >= 0.7 x at 100 ("flat per-agent
+# cost"); lockstep >= 0.7 x ceiling at 100 and at 200 ("near the ceiling"). A target whose counts
+# were not run is not printed. Exit status 0 whether or not targets pass (the table is the output).
 # usage: benchmark/throughput_table.sh [agent counts (default 100 200)]
+# environment: VF_BENCH_PORT_BASE (default 11500; the masters use 100 ports from there).
 source "$(dirname "${BASH_SOURCE[0]}")/../scripts/common.sh"
 vf_install_dependencies
 vf_build
 vf_source
 counts=("$@"); [ ${#counts[@]} -eq 0 ] && counts=(100 200)
-rows=()
-port=11690
+port_base="${VF_BENCH_PORT_BASE:-11500}"
+declare -A rate ceiling
 for n in "${counts[@]}"; do
-  package=$(VF_BENCH_MODES=nodelet "$REPO/scripts/benchmark_ros.sh" "$n" 2>/dev/null |
-            awk -v n="$n" '$1 == n && $2 == "nodelet" { print $4; exit }')
-  port=$((port + 1))
+  rate[$n]=$(VF_BENCH_MODES=nodelet VF_BENCH_PORT_BASE="$port_base" VF_BENCH_PORTS=90 "$REPO/scripts/benchmark_ros.sh" "$n" 2>/dev/null |
+             awk -v n="$n" '$1 == n && $2 == "nodelet" { print $4; exit }')
+  port="$(vf_free_port $((port_base + 90)) 10)"
   rosmaster --core -p "$port" >/dev/null 2>&1 &
   master=$!
   sleep 1
-  ceiling=$(ROS_MASTER_URI="http://localhost:$port" timeout 300 "$WS/devel/lib/variational_formation/benchmark_transport" \
-              --agents "$n" --steps $(( n <= 100 ? 3000 : 1500 )) --collector batch --remote 2>/dev/null |
-            sed -nE 's/.* ([0-9]+) steps\/s$/\1/p')
+  ceiling[$n]=$(ROS_MASTER_URI="http://localhost:$port" timeout 300 "$WS/devel/lib/variational_formation/benchmark_transport" \
+                  --agents "$n" --steps $(( 300000 / n > 300 ? 300000 / n : 300 )) --collector batch --remote 2>/dev/null |
+                sed -nE 's/.* ([0-9]+) steps\/s$/\1/p')
   kill "$master" 2>/dev/null || true
   wait "$master" 2>/dev/null || true
-  ratio=$(awk -v a="${package:-0}" -v b="${ceiling:-0}" 'BEGIN { if (a > 0 && b > 0) printf "%.2f", a / b; else print "n/a" }')
-  rows+=("| $n | ${package:-failed} | ${ceiling:-failed} | $ratio |")
 done
-echo "| agents | steps/s (nodelets) | transport ceiling, steps/s | ratio |"
-echo "| --- | --- | --- | --- |"
-printf '%s\n' "${rows[@]}"
+reference=${counts[0]}
+for n in "${counts[@]}"; do [ "$n" = 100 ] && reference=100; done
+# a / b to two decimals, or n/a when either is missing or zero.
+ratio() { awk -v a="${1:-0}" -v b="${2:-0}" 'BEGIN { if (a > 0 && b > 0) printf "%.2f", a / b; else print "n/a" }'; }
+echo "| agents | steps/s | agent-steps/s | µs per agent-step | ratio to $reference | ceiling, steps/s | ceiling ratio to $reference | lockstep / ceiling |"
+echo "| --- | --- | --- | --- | --- | --- | --- | --- |"
+for n in "${counts[@]}"; do
+  r=${rate[$n]:-} c=${ceiling[$n]:-}
+  per=$(awk -v r="${r:-0}" -v n="$n" 'BEGIN { if (r > 0) printf "%.1f", 1e6 / (r * n); else print "n/a" }')
+  echo "| $n | ${r:-failed} | $(( ${r:-0} * n )) | $per | $(ratio $(( ${r:-0} * n )) $(( ${rate[$reference]:-0} * reference ))) |" \
+       "${c:-failed} | $(ratio $(( ${c:-0} * n )) $(( ${ceiling[$reference]:-0} * reference ))) | $(ratio "$r" "$c") |"
+done
+echo
+# target NAME VALUE THRESHOLD: one line, pass or fail.
+target() {
+  awk -v name="$1" -v v="$2" -v t="$3" 'BEGIN {
+    if (v == "n/a") printf "%s: n/a (a run failed): FAIL\n", name
+    else printf "%s: %s (target >= %s): %s\n", name, v, t, (v + 0 >= t + 0 ? "pass" : "FAIL") }'
+}
+has() { [ -n "${rate[$1]+x}" ]; }
+if has 100; then
+  for n in 200 1000; do
+    has "$n" || continue
+    t=$([ "$n" = 200 ] && echo 0.8 || echo 0.7)
+    target "flat per-agent cost, agent-steps/s at $n / at 100" "$(ratio $(( ${rate[$n]:-0} * n )) $(( ${rate[100]:-0} * 100 )))" "$t"
+  done
+fi
+for n in 100 200; do
+  has "$n" && target "near the ceiling, lockstep / ceiling at $n" "$(ratio "${rate[$n]}" "${ceiling[$n]}")" 0.7
+done
+if has 100 && has 200; then
+  echo "ceiling's own flatness, agent-steps/s at 200 / at 100: $(ratio $(( ${ceiling[200]:-0} * 200 )) $(( ${ceiling[100]:-0} * 100 )))"
+fi
+exit 0

@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # Where the time of a nodelet run goes: one ring formation (make_scenario) per agent count, all
 # agents in formation/manager, run as fast as possible on its own ROS master (a free port in
-# 11600-11649; 800000 / n steps, about 20-30 s). While it runs, `perf record` samples the manager and the monitor for
+# 11600-11649, or VF_PROFILE_PORT_BASE and the 50 above it; 800000 / n steps, about 20-30 s). While it runs, `perf record` samples the manager and the monitor for
 # VF_PROFILE_SECONDS (default 5) s (and the recorder, with record:=true), and the script prints
 # for each:
 #   - its share of the machine's CPU over that window (100 = one core), from /proc;
 #   - perf's split of its samples by library: kernel, roscpp (roscpp, serialisation, xmlrpc,
 #     rosconsole, cpp_common), libc/libstdc++ (locks, allocation), tf2, the package's ROS layer,
 #     the package's core (the maths), other.
+# VF_PROFILE_STEPS sets the steps of every run (a loaded machine needs more).
 # VF_PROFILE_SYMBOLS=N also prints each process's N functions with the most samples.
 # With extra launch arguments after "--" (e.g. -- record:=true marker_every:=10) they are added
 # to every run.
@@ -49,11 +50,11 @@ split_by_library() {
 }
 
 for n in "${counts[@]}"; do
-  steps=$(( 800000 / n ))
+  steps=${VF_PROFILE_STEPS:-$(( 800000 / n ))}
   scenario="$tmp/ring$n.yaml"
   rosrun variational_formation make_scenario --shape ring --agents "$n" --perturb 0.05 --seed 1 \
     --steps "$steps" --name "ring$n" --out "$scenario"
-  port="$(vf_free_port 11600 50)"
+  port="$(vf_free_port "${VF_PROFILE_PORT_BASE:-11600}" 50)"
   log="$tmp/log$n"
   ROS_MASTER_URI="http://localhost:$port" ROS_LOG_DIR="$tmp/ros_log" \
     timeout -s INT -k 30 600 roslaunch -p "$port" variational_formation formation.launch \
@@ -70,9 +71,19 @@ for n in "${counts[@]}"; do
   sleep 1
   # The manager and the monitor, and the recorder with record:=true.
   names=() pids=()
-  for spec in "manager:agent_manager __name:=manager" "monitor:/monitor __name:=monitor" \
-              "recorder:/recorder __name:=recorder"; do
-    pid=$(pgrep -f "${spec#*:}" | head -n 1 || true)
+  # Among this launch's own processes (others may run formations on the same machine), by
+  # executable and node name (a node's remappings come between them).
+  for spec in "manager:/agent_manager .*__name:=manager" "monitor:/monitor .*__name:=monitor" \
+              "recorder:/recorder .*__name:=recorder"; do
+    pid=$(ps -e -o pid=,ppid=,args= | awk -v root="$launch" -v pattern="${spec#*:}" '
+      { parent[$1] = $2; line[$1] = $0 }
+      END {
+        for (p in parent) {
+          q = p
+          while (q in parent && q != root && q > 1) q = parent[q]
+          if (q == root && line[p] ~ pattern) { print p; exit }
+        }
+      }' || true)
     if [ -n "$pid" ]; then names+=("${spec%%:*}"); pids+=("$pid"); fi
   done
   if [ "${names[0]:-}" != manager ] || [ "${names[1]:-}" != monitor ]; then

@@ -65,19 +65,19 @@ double largestEigenvalue(const Eigen::SparseMatrix<double>& a) {
   Eigen::VectorXd v(n);
   for (Eigen::Index i = 0; i < n; ++i) v(i) = uniform(generator);
   v.normalize();
-  Eigen::MatrixXd basis(n, maxSteps);
+  // The three-term recurrence only, O(n) memory and work per step: without reorthogonalisation
+  // the Ritz values gain copies of converged eigenvalues ("ghosts"), never a value above
+  // lambda_max, so the top one still rises to lambda_max. Full reorthogonalisation against every
+  // earlier vector cost O(n m^2): 17 of the 20 s of loading a 10,000-agent ring.
+  Eigen::VectorXd previous = Eigen::VectorXd::Zero(n);
   std::vector<double> alpha, beta;
   double top = 0.0;
   int steady = 0;  // consecutive checks in which the top Ritz value stood still
   for (Eigen::Index j = 0; j < maxSteps; ++j) {
-    basis.col(j) = v;
     Eigen::VectorXd w = a * v;
+    if (j > 0) w -= beta.back() * previous;
     alpha.push_back(v.dot(w));
-    // Full reorthogonalisation, twice ("twice is enough"): the Ritz values stay those of an
-    // orthonormal basis, without spurious copies.
-    for (int pass = 0; pass < 2; ++pass) {
-      w -= basis.leftCols(j + 1) * (basis.leftCols(j + 1).transpose() * w);
-    }
+    w -= alpha.back() * v;
     const double b = w.norm();
     const Eigen::Index m = j + 1;
     if (m % 8 == 0 || b == 0.0 || m == maxSteps) {
@@ -88,13 +88,14 @@ double largestEigenvalue(const Eigen::SparseMatrix<double>& a) {
                                   : Eigen::VectorXd();
       Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> t;
       t.computeFromTridiagonal(diagonal, sub, Eigen::EigenvaluesOnly);
-      const double previous = top;
+      const double before = top;
       top = t.eigenvalues()(m - 1);
-      steady = std::abs(top - previous) <= 1e-14 * std::abs(top) ? steady + 1 : 0;
+      steady = std::abs(top - before) <= 1e-14 * std::abs(top) ? steady + 1 : 0;
       if (steady >= 2) break;
     }
     if (b == 0.0) break;
     beta.push_back(b);
+    previous = v;
     v = w / b;
   }
   return top;
@@ -104,7 +105,10 @@ int sparseRank(const Eigen::SparseMatrix<double>& a, double relativeTolerance) {
   if (a.nonZeros() == 0) return 0;
   double largest = 0.0;
   for (Eigen::Index c = 0; c < a.cols(); ++c) largest = std::max(largest, a.col(c).norm());
-  Eigen::SparseQR<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> qr;
+  // The columns in the formation's own order: COLAMD's ordering fills a ring's R almost densely
+  // (0.95 M entries at 1000 agents against 19 k, 2.7 s against 5 ms; 10,000 agents take 0.5 s),
+  // and formations are numbered along their shape (make_scenario's generators are).
+  Eigen::SparseQR<Eigen::SparseMatrix<double>, Eigen::NaturalOrdering<int>> qr;
   qr.setPivotThreshold(relativeTolerance * std::max(1.0, largest));
   Eigen::SparseMatrix<double> compressed = a;
   compressed.makeCompressed();

@@ -17,14 +17,14 @@ Eigen::SparseMatrix<double> sparseHessian(const Formation& formation, const Posi
 Eigen::SparseMatrix<double> sparseRigidityMatrix(const Formation& formation, const Positions& q);
 
 /**
- * Largest eigenvalue of a symmetric matrix, by Lanczos with full reorthogonalisation from a
- * fixed start vector (deterministic). Stops when the top Ritz value has moved by less than 1e-14
- * of itself at two checks in a row (every 8 steps), or after min(n, 600) steps; the Ritz value
- * never exceeds the true one.
+ * Largest eigenvalue of a symmetric matrix, by Lanczos (the three-term recurrence, O(n) work
+ * per step) from a fixed start vector (deterministic). Stops when the top Ritz value has moved by
+ * less than 1e-14 of itself at two checks in a row (every 8 steps), or after min(n, 600) steps.
  */
 double largestEigenvalue(const Eigen::SparseMatrix<double>& a);
 
-/// Numerical rank of a sparse matrix by a sparse QR (COLAMD ordering): diagonal entries of R
+/// Numerical rank of a sparse matrix by a sparse QR, its columns in their own order (a
+/// formation's numbering along its shape keeps R banded): diagonal entries of R
 /// above relativeTolerance x max(1, largest column norm) count.
 int sparseRank(const Eigen::SparseMatrix<double>& a, double relativeTolerance);
 
