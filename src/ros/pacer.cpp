@@ -1,7 +1,5 @@
 #include "variational_formation/ros/pacer.hpp"
 
-#include <boost/make_shared.hpp>
-
 namespace vf {
 
 Pacer& Pacer::instance() {
@@ -49,7 +47,7 @@ void Pacer::run() {
     const Clock::time_point until = Clock::now() + grain;
     while (!due_.empty() && due_.begin()->first <= until) {
       Entry& e = due_.begin()->second;
-      e.queue->addCallback(boost::make_shared<QueuedCall>(std::move(e.call)), e.owner);
+      e.queue->addCallback(ros::CallbackInterfacePtr(new QueuedCall(std::move(e.call))), e.owner);
       due_.erase(due_.begin());
     }
   }
