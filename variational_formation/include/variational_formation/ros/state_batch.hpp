@@ -1,0 +1,114 @@
+#pragma once
+
+#include <condition_variable>
+#include <atomic>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <ros/callback_queue.h>
+#include <ros/ros.h>
+
+#include "variational_formation_msgs/AgentState.h"
+#include "variational_formation_msgs/AgentStates.h"
+
+namespace vf {
+
+/**
+ * An agent manager's batch of its agents' states (doc/distributed.md, "Batches"): the agents
+ * loaded in this process add each state they publish, and it goes out on the manager's `~states`
+ * as one AgentStates once every agent of ~agents has added one, or within 5 ms of the first state
+ * it holds. The monitor and the recorder then take one message and one wake-up per step from a
+ * manager instead of one per agent. One per process, started by agent_manager before it loads
+ * its agents; agents in any other process have none. Thread-safe: the manager's workers add.
+ */
+class StateBatch {
+ public:
+  /// Starts this process's batch for agents `ids`, on `pnh`'s `states` (the manager's private handle).
+  static void start(ros::NodeHandle& pnh, const std::vector<int>& ids);
+  /// This process's batch; nullptr if it has none.
+  static StateBatch* local();
+
+  /// Ends this process's batch (before ROS shuts down).
+  static void stop();
+  ~StateBatch();
+
+  /// A state its agent just published; states of agents not in ~agents are left out.
+  void add(const variational_formation_msgs::AgentState::ConstPtr& state);
+  /// ~agents: the agents this manager batches.
+  const std::set<int>& ids() const { return ids_; }
+
+ private:
+  StateBatch(ros::NodeHandle& pnh, const std::vector<int>& ids);
+  /// Every 5 ms until stopped, on a thread of its own: a roscpp timer would cost every other timer
+  /// of the process a search through all of them each time it fires (TimerManager::findTimer).
+  void flushEvery5ms();
+  void flush();
+  /// A subscriber that connects gets each agent's newest state at once, as the latched
+  /// agent_<i>/state topics give it (a monitor or recorder started late misses nothing).
+  void onConnect(const ros::SingleSubscriberPublisher& subscriber);
+
+  std::set<int> ids_;
+  std::mutex mutex_;
+  variational_formation::AgentStatesPtr pending_;
+  std::map<int, variational_formation_msgs::AgentState::ConstPtr> newest_;
+  ros::Publisher pub_;
+  bool stopping_ = false;  // guarded by mutex_
+  std::condition_variable stop_;
+  std::thread flusher_;
+};
+
+/**
+ * The callback threads of an agent manager's own agents (doc/distributed.md, "Threads"): agent k
+ * (in load order) runs its callbacks on queue k mod T, each served by a thread of its own, so a
+ * state passes from one agent to the next with one hand-over between threads, where nodelet's
+ * queue manager needs two (its manager thread, then a worker). One agent's callbacks stay on one
+ * thread, one at a time, as in a node. One per process, started by agent_manager; agents loaded
+ * in any other manager keep nodelet's queues.
+ */
+class AgentThreads {
+ public:
+  /// Starts `threads` (>= 1) queues and threads for this process.
+  static void start(int threads);
+  /// Destroys this process's threads and queues (halting them first).
+  static void stop();
+  /// Joins the threads and disables the queues: no agent callback runs afterwards, and a callback
+  /// added later is ignored (the queues stay, for agents that are still being unloaded).
+  void halt();
+  /// This process's, or nullptr.
+  static AgentThreads* local();
+  /// The queue of the next agent loaded.
+  ros::CallbackQueue* nextQueue();
+  ~AgentThreads();
+
+ private:
+  explicit AgentThreads(int threads);
+
+  std::vector<std::unique_ptr<ros::CallbackQueue>> queues_;
+  std::vector<std::thread> threads_;
+  std::size_t next_ = 0;  // guarded by mutex_
+  std::mutex mutex_;
+  std::atomic<bool> stopping_{false};
+};
+
+/// Agents `ids` whose states come batched from `manager` (its full name).
+struct BatchSource {
+  std::string manager;
+  std::set<int> ids;
+};
+
+/**
+ * The managers among `managers` (full names) that batch their agents' states: each agent_manager
+ * publishes its ~agents parameter, and only it batches. An agent listed by two managers is left
+ * to its own topic. @param agents the formation's size: ids beyond it are ignored.
+ */
+std::vector<BatchSource> batchSources(const ros::NodeHandle& nh, const std::vector<std::string>& managers, int agents);
+
+/// The agent ids in ~agents text ("0 1 2"). @throws InvalidInput naming `parameter`.
+std::vector<int> parseAgentIds(const std::string& list, const std::string& parameter);
+
+}  // namespace vf

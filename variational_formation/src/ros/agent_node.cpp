@@ -1,0 +1,188 @@
+#include "variational_formation/ros/agent_node.hpp"
+
+#include <algorithm>
+#include <functional>
+
+#include <ros/callback_queue.h>
+
+#include "variational_formation_core/model/validation.hpp"
+#include "variational_formation/ros/pacer.hpp"
+#include "variational_formation/ros/parameters.hpp"
+#include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/progress_message.hpp"
+#include "variational_formation/ros/sensing_hub.hpp"
+#include "variational_formation/ros/state_batch.hpp"
+
+namespace vf {
+
+namespace {
+constexpr double kReportEvery = 5.0;  // seconds between "waiting for ..." lines
+
+}  // namespace
+
+AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
+  const int id = requiredParam<int>(pnh, "id");
+  const std::string path = requiredParam<std::string>(pnh, "scenario");
+  realTimeFactor_ = optionalParam(pnh, "real_time_factor", 0.0);
+  monitor_ = participantName(nh, optionalParam<std::string>(pnh, "monitor", "monitor"));
+  const Scenario scenario = sharedScenario(path);
+  validateRealTimeFactor(realTimeFactor_, scenario.timeStep, "~real_time_factor");
+  managers_ = agentManagers(nh, pnh);
+  const std::shared_ptr<SensingBoard> board = SensingHub::board(nh, scenario, managers_);
+  sharedBoard_ = board != nullptr;
+  protocol_ = std::make_unique<Protocol>(
+      LockstepAgent(scenario, id, StartMethod::Variational, board),
+      [this](const LockstepAgent& a, const std::string& failure) { return makeState(a, failure); }, realTimeFactor_,
+      [] { return ros::WallTime::now().toSec(); }, Pacer::kGrain);
+  name_ = "agent_" + std::to_string(id);
+  // Frames carry the namespace, so that two formations side by side have distinct frames.
+  const std::string ns = framePrefix(nh);
+  frame_ = ns + name_;
+  worldFrame_ = worldFrame(pnh);
+  statePub_ = nh.advertise<AgentState>(name_ + "/state", 1000, /*latch=*/true);
+  for (int j = 0; j < scenario.agentCount(); ++j) owners_.push_back(agentNodeName(nh, j));
+  // Served from the start, so that restarting neighbours can ask; the subscriptions wait for
+  // start(), which resumes the agent before any state reaches it.
+  recallServer_ = nh.advertiseService(name_ + "/recall", &AgentNode::onRecall, this);
+  historyServer_ = nh.advertiseService(name_ + "/history", &AgentNode::onHistory, this);
+  for (const std::string& w : scenario.warnings) ROS_WARN("%s: %s", name_.c_str(), w.c_str());
+  ROS_INFO("%s: scenario '%s' (%s), %d neighbours, kappa %g, h %g, %ld steps%s, real-time factor %g, monitor %s",
+           name_.c_str(), scenario.name.c_str(), path.c_str(), static_cast<int>(agent().neighbourIds().size()),
+           scenario.dampingGain, scenario.timeStep, scenario.steps, scenario.steps == 0 ? " (unbounded)" : "",
+           realTimeFactor_, monitor_.c_str());
+  if (scenario.safety) {
+    ROS_INFO("%s: safety filter on (r %g, sensing radius %g); every agent's state from %s", name_.c_str(),
+             scenario.safety->radius, scenario.safety->sensingRadius,
+             sharedBoard_ ? "the manager's shared board" : "its own topic");
+  }
+}
+
+AgentNode::~AgentNode() {
+  *alive_ = false;
+  Pacer::instance().cancel(reinterpret_cast<uint64_t>(this));
+}
+
+std::vector<int> AgentNode::sources() const {
+  if (!agent().board() || sharedBoard_) return agent().neighbourIds();
+  std::vector<int> all;
+  for (int j = 0; j < agent().scenario().agentCount(); ++j) {
+    if (j != agent().id()) all.push_back(j);
+  }
+  return all;
+}
+
+void AgentNode::wakeWhenSensed() {
+  if (!sharedBoard_ || wakeStep_ == agent().step()) return;
+  wakeStep_ = agent().step();
+  ros::CallbackQueueInterface* queue = nh_.getCallbackQueue();
+  const std::shared_ptr<bool> alive = alive_;
+  agent().board()->whenComplete(agent().step(), [this, queue, alive] {
+    queue->addCallback(boost::make_shared<QueuedCall>([this, alive] {
+      if (*alive) carryOut(protocol_->step(Protocol::Wake{}));
+    }), reinterpret_cast<uint64_t>(this));
+  });
+}
+
+void AgentNode::drop(const std::string& why) {
+  ++dropped_;
+  ROS_WARN_THROTTLE(1.0, "%s: dropped %s; %ld dropped so far", name_.c_str(), why.c_str(), dropped_);
+}
+
+void AgentNode::carryOut(const Protocol::Ready& ready) {
+  if (!ready.failed.empty()) ROS_ERROR("%s: %s; ending the run", name_.c_str(), ready.failed.c_str());
+  for (const AgentState::ConstPtr& state : ready.publish) publish(state);
+  if (!ready.dropped.empty()) drop(ready.dropped);
+  if (!ready.over.empty()) ROS_INFO("%s: %s", name_.c_str(), ready.over.c_str());
+  if (ready.wakeWhenSensed) wakeWhenSensed();
+  if (ready.wakeAfter > 0.0) paceFor(ready.wakeAfter);
+}
+
+void AgentNode::paceFor(double wait) {
+  if (pacedStep_ == agent().step()) return;  // already waiting for this step's release
+  pacedStep_ = agent().step();
+  const std::shared_ptr<bool> alive = alive_;
+  const auto due = Pacer::Clock::now() + std::chrono::duration_cast<Pacer::Clock::duration>(std::chrono::duration<double>(wait));
+  Pacer::instance().at(due, nh_.getCallbackQueue(), reinterpret_cast<uint64_t>(this), [this, alive] {
+    if (!*alive) return;
+    pacedStep_ = -1;
+    carryOut(protocol_->step(Protocol::Wake{}));
+  });
+}
+
+void AgentNode::onNeighbourState(int neighbour, const ros::MessageEvent<AgentState const>& event) {
+  if (!fromAgent(event, owners_[static_cast<std::size_t>(neighbour)], managers_)) {
+    drop("a state on agent_" + std::to_string(neighbour) + "'s topic from " + event.getPublisherName() +
+         ", which does not own it");
+    return;
+  }
+  carryOut(protocol_->step(Protocol::StateArrived{neighbour, event.getConstMessage()}));
+}
+
+void AgentNode::onProgress(const ros::MessageEvent<RunProgress const>& event) {
+  if (!fromOwner(event, monitor_)) {
+    drop("a progress message from " + event.getPublisherName() + ", which is not the monitor " + monitor_);
+    return;
+  }
+  const RunProgress& p = *event.getConstMessage();
+  carryOut(protocol_->step(Protocol::ProgressArrived{agentProgressOf(p), p}));
+}
+
+AgentState::ConstPtr AgentNode::makeState(const LockstepAgent& a, const std::string& failure) const {
+  // Built once and published as a pointer to const: subscribers in the same process (nodelets in
+  // one manager) receive this very object, without a copy or serialisation.
+  const AgentStatePtr state = boost::make_shared<AgentState>();
+  AgentState& msg = *state;
+  msg.header.stamp.fromSec(a.time());
+  msg.header.frame_id = worldFrame_;
+  msg.id = static_cast<uint32_t>(a.id());
+  msg.step = a.step();
+  msg.time = a.time();
+  msg.position = a.position();
+  msg.previous_position = a.previousPosition();
+  msg.dropped = static_cast<uint32_t>(dropped_);
+  msg.constraints_active = static_cast<uint32_t>(a.constraintsActive());
+  msg.failure = failure;
+  return state;
+}
+
+void AgentNode::publish(const AgentState::ConstPtr& state) {
+  statePub_.publish(state);
+  if (StateBatch* batch = StateBatch::local()) batch->add(state);  // in an agent_manager
+  tf_.sendTransform(frameAt(state->header, frame_, state->position));
+}
+
+void AgentNode::reportWaiting() {
+  if (protocol_->exitStatus() >= 0) return;
+  const double stepAt = protocol_->lastStepAt();
+  const ros::WallTime last = stepAt < 0.0 ? lastReportAt_ : std::max(ros::WallTime(stepAt), lastReportAt_);
+  if (secondsSince(last) < kReportEvery) return;
+  ROS_INFO("%s: at step %ld, waiting for %s", name_.c_str(), agent().step(), protocol_->waitingFor(monitor_).c_str());
+  lastReportAt_ = ros::WallTime::now();
+}
+
+void AgentNode::start(const Recovery& recovery) {
+  resume(recovery);
+  subscribeToFormation(
+      nh_, sources(), 1000,
+      [this](int j, const ros::MessageEvent<AgentState const>& e) { onNeighbourState(j, e); },
+      [this](const ros::MessageEvent<RunProgress const>& e) { onProgress(e); }, subs_, progressSub_);
+  commandSub_ = nh_.subscribe<variational_formation_msgs::FormationCommands>(
+      "command", 10,
+      boost::function<void(const ros::MessageEvent<variational_formation_msgs::FormationCommands const>&)>(
+          [this](const ros::MessageEvent<variational_formation_msgs::FormationCommands const>& e) { onCommands(e); }),
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  carryOut(protocol_->start());  // the first state (step 0, or the recovered one), latched
+  lastReportAt_ = ros::WallTime::now();
+  // Every 2.5 s (a waiting line every 5 s at most), from the process's one PeriodicCall thread:
+  // a manager holds up to thousands of agents, and a roscpp timer each would stall it.
+  watch_ = PeriodicCall(nh_.getCallbackQueue(), kReportEvery / 2, [this] { reportWaiting(); });
+}
+
+int AgentNode::run() {
+  start(askHolders());
+  while (ros::ok()) ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.1));
+  ROS_INFO("%s: done at step %ld, %ld states dropped", name_.c_str(), agent().step(), dropped_);
+  return protocol_->exitStatus() < 0 ? 0 : protocol_->exitStatus();
+}
+
+}  // namespace vf

@@ -1,0 +1,123 @@
+// What the monitor publishes and writes, in both modes: a completed step's status, markers and
+// /clock, and at the end the result file and the final progress (MonitorNode, monitor_node.hpp).
+#include <fstream>
+#include <limits>
+
+#include <rosgraph_msgs/Clock.h>
+
+#include "variational_formation_core/agents/run_verdict.hpp"
+#include "variational_formation/ros/markers.hpp"
+#include "variational_formation/ros/monitor_node.hpp"
+
+namespace vf {
+
+MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, const ros::Time& stamp,
+                                                    double dataAge, bool noetherHolds) {
+  const ros::WallTime now = ros::WallTime::now();
+  if (s.metrics.step == 0) firstStepAt_ = now;
+  lastCompletedAt_ = now;
+  trails_.add(s.metrics.step, s.positions);
+  Published out;
+  FormationStatus& status = out.first;
+  status = toStatusMessage(s);
+  status.header.stamp = stamp;
+  status.header.frame_id = worldFrame_;
+  status.dropped = static_cast<uint32_t>(dropped_);
+  status.max_data_age = dataAge;
+  status.commands = static_cast<uint32_t>(commandsIssued());
+  status.shape_error = s.shape.shapeError;  // NaN at steps it skips (FormationSnapshot::shape)
+  noteShape(s);
+  status.min_separation = std::numeric_limits<double>::quiet_NaN();  // without a safety block (FormationStatus.msg)
+  const bool blocked = watchSafety(s, status);
+  watchRobots(s, status);
+  if (!noetherHolds) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    status.linear_momentum_predicted.x = status.linear_momentum_predicted.y = status.linear_momentum_predicted.z = nan;
+    status.angular_momentum_predicted.x = status.angular_momentum_predicted.y = nan;
+    status.angular_momentum_predicted.z = nan;
+  }
+  statusPub_.publish(status);
+  goals_->onStep(s.metrics.step, s.positions, s.converged, s.metrics.maxDistanceError, stamp);
+  // Never backwards: with several formations on one master, the one furthest ahead sets it.
+  if (publishClock_ && (!ros::Time::isSimTime() || stamp >= ros::Time::now())) {
+    rosgraph_msgs::Clock clock;
+    clock.clock = stamp;
+    clockPub_.publish(clock);
+  }
+  // Markers cost O(n + |E|) per step (trails thinned to a bound, Trails): built only when someone
+  // takes them (the recorder, a viewer), every marker_every steps, and always at the first and
+  // last step so that the latched one is right. The trails above still get every step.
+  const long last = scenario_.steps;
+  const bool edge = s.metrics.step == 0 || (last > 0 && s.metrics.step == last);
+  if (edge || (s.metrics.step % markerEvery_ == 0 && (recording_ || markersPub_.getNumSubscribers() > 0))) {
+    out.second = makeMarkers(s, measure().formation(), trails_, commandSchedule(), scenario_.timeStep);
+    if (scenario_.safety) addSafetyMarkers(s, *scenario_.safety, scenario_.obstacles, out.second);
+    for (auto& m : out.second.markers) {
+      m.header.stamp = stamp;
+      m.header.frame_id = worldFrame_;
+    }
+    markersPub_.publish(out.second);
+  }
+  convergedStep_ = s.converged ? s.convergedStep : -1;
+  finalError_ = s.metrics.maxDistanceError;
+  if (s.converged && reportedConvergence_ != s.convergedStep) {
+    ROS_INFO("monitor: congruent with the desired shape since step %ld (t = %.3f s)", s.convergedStep,
+             s.convergedStep * scenario_.timeStep);
+    reportedConvergence_ = s.convergedStep;
+  } else if (!s.converged && reportedConvergence_ >= 0) {
+    ROS_INFO("monitor: left the desired shape at step %ld", s.metrics.step);
+    reportedConvergence_ = -2;
+  }
+  if (blocked) finish(RunProgress::FINISHED, "");  // the formation cannot form: say so instead of running on
+  return out;
+}
+
+void MonitorNode::writeResult(const std::string& result, const std::string& reason) const {
+  if (resultFile_.empty()) return;
+  std::ofstream f(resultFile_);
+  std::string quoted;
+  for (char c : reason) quoted += c == '"' ? std::string("\\\"") : std::string(1, c);
+  const ShapeOutcome formation = shapeVerdict();
+  f << "result: " << result << "\nscenario: " << scenario_.name << "\nsteps: " << scenario_.steps
+    << "\ncompleted_step: " << completedStep() << "\nconverged_step: " << formation.convergedStep
+    << "\nshape_error: " << formation.findings.shapeError << "\nformation: \""
+    << formation.line << "\"\nfinal_max_distance_error: " << finalError_ << "\ndropped: " << dropped_ << "\ncommands: " << commandsIssued()
+    << "\ncommands_refused: " << commandsRefused_ << "\ncommands_saturated: " << desk_->saturated()
+    << "\nreason: \"" << quoted << "\"\n" << safetyResultLines() << robotsResultLines();
+  if (!f) ROS_ERROR("monitor: cannot write the result file %s", resultFile_.c_str());
+}
+
+void MonitorNode::finish(uint8_t state, std::string reason) {
+  if (ended()) return;
+  const long last = completedStep();
+  goals_->end("the run ended at step " + std::to_string(last));
+  const double h = scenario_.timeStep;
+  const ShapeOutcome formation = shapeVerdict();
+  const RunVerdict verdict = finishedRunVerdict(scenario_, formation);
+  if (state == RunProgress::FINISHED) {
+    const double seconds = (ros::WallTime::now() - firstStepAt_).toSec();
+    ROS_INFO("monitor: %ld steps in %.3f s: %.0f steps/s, real-time factor %.1f at h = %g; %s; %ld dropped", last,
+             seconds, last / seconds, last * h / seconds, h, formation.line.c_str(), dropped_);
+  }
+  if (state == RunProgress::FINISHED && !verdict.succeeded) {
+    state = RunProgress::FAILED;  // the scenario asked for a formation that did not form
+    reason = verdict.reason;
+  }
+  if (state == RunProgress::FINISHED) {
+    writeResult("succeeded", "");
+    // The last line says whether the formation formed: a run that never formed is no plain success.
+    ROS_INFO("monitor: run succeeded; formation %s (%s)", formation.line.c_str(),
+             resultFile_.empty() ? "no result file" : resultFile_.c_str());
+    exitStatus_ = 0;
+  } else {
+    writeResult("failed", reason);
+    ROS_ERROR("monitor: run failed at step %ld: %s", last, reason.c_str());
+    exitStatus_ = 1;
+  }
+  progress_.state = state;
+  progress_.reason = reason;
+  progress_.header.stamp = stampOf(progress_.completed_step);
+  progressPub_.publish(progress_);
+}
+
+}  // namespace vf

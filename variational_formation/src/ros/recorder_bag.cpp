@@ -1,0 +1,98 @@
+// The recorder's bag (RecorderNode, recorder_node.hpp): its files and their limits, and the
+// whole steps written in order.
+#include <algorithm>
+
+#include <tf2_msgs/TFMessage.h>
+
+#include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/recorder_node.hpp"
+
+namespace vf {
+
+namespace {
+/// Bag time of a message stamped with simulated time t_k (a bag cannot hold time 0).
+ros::Time bagTime(const ros::Time& stamp) { return std::max(stamp, ros::TIME_MIN); }
+}  // namespace
+
+void RecorderNode::openPart() {
+  std::string path = path_;
+  if (part_ > 0) {
+    const std::string stem = path_.size() > 4 && path_.compare(path_.size() - 4, 4, ".bag") == 0
+                                 ? path_.substr(0, path_.size() - 4) : path_;
+    path = stem + "_" + std::to_string(part_) + ".bag";
+  }
+  try {
+    bag_.open(path, rosbag::bagmode::Write);
+    open_ = true;
+  } catch (const std::exception& e) {
+    throw InvalidInput("~bag: cannot write '" + path + "': " + e.what());
+  }
+}
+
+void RecorderNode::enforceLimits() {
+  const double size = static_cast<double>(bag_.getSize());
+  if (maxBytes_ > 0.0 && closedBytes_ + size >= maxBytes_) {
+    limited_ = true;
+    ROS_WARN("recorder: the size limit of %.0f MB ends the recording (%d files); the run goes on", maxBytes_ / 1e6,
+             part_ + 1);
+    close("size limit");
+  } else if (splitBytes_ > 0.0 && size >= splitBytes_) {
+    closedBytes_ += size;
+    close("split");
+    ++part_;
+    try {
+      openPart();
+    } catch (const std::exception& e) {
+      fail(e.what());
+    }
+  }
+}
+
+template <typename M>
+void RecorderNode::write(const std::string& topic, const M& msg, const ros::Time& stamp) {
+  if (!open_) return;
+  try {
+    bag_.write(topic, bagTime(stamp), msg);
+    ++written_;
+    enforceLimits();
+  } catch (const std::exception& e) {
+    fail(std::string("cannot write ") + path_ + ": " + e.what());
+  }
+}
+
+void RecorderNode::writeStep(const Protocol::Write& w) {
+  // Steps come whole and in order, so the bag's messages are in time order: readers that trust
+  // it (Python's rosbag merges chunks assuming it) see every stream in step order.
+  const Protocol::Step& step = w.step;
+  if (w.commands > 0) writeListedCommands(w.commands, step.step);
+  // The step's transforms in one /tf message, as a broadcaster of many frames sends them: a
+  // bag message costs the same whatever it holds, and 1000 agents wrote 2000 a step.
+  tf2_msgs::TFMessage tf;
+  tf.transforms.reserve(step.states.size());
+  for (std::size_t i = 0; i < step.states.size(); ++i) {
+    const AgentState& msg = *step.states[i];
+    write(stateTopics_[i], msg, msg.header.stamp);
+    tf.transforms.push_back(frameAt(msg.header, frameIds_[i], msg.position));
+  }
+  if (!tf.transforms.empty()) write("/tf", tf, tf.transforms.front().header.stamp);
+  write(statusTopic_, *step.status, step.status->header.stamp);
+  if (step.hasMarkers) write(markersTopic_, *step.markers, markersStamp(*step.markers));
+}
+
+void RecorderNode::writeListedCommands(std::size_t count, long step) {
+  variational_formation_msgs::FormationCommands so_far;
+  so_far.header.stamp = ros::Time(static_cast<double>(step) * timeStep_);
+  so_far.commands.assign(commands_.commands.begin(), commands_.commands.begin() + static_cast<long>(count));
+  write(commandsTopic_, so_far, so_far.header.stamp);
+}
+
+void RecorderNode::close(const std::string& how) {
+  if (!open_) return;
+  open_ = false;
+  bag_.close();
+  ROS_INFO("recorder: %s closed (%s): %ld messages, %ld repeated states not written again (%ld equal to the "
+           "written copy bit for bit, %ld too old to compare), %ld dropped", path_.c_str(), how.c_str(), written_,
+           protocol_->repeats(), protocol_->repeats() - protocol_->uncompared(), protocol_->uncompared(), dropped_);
+}
+
+}  // namespace vf

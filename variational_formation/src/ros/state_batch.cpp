@@ -1,0 +1,173 @@
+#include "variational_formation/ros/state_batch.hpp"
+
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include "variational_formation_core/common/invalid_input.hpp"
+
+namespace vf {
+
+namespace {
+constexpr double kFlushAfter = 0.005;  // [s] a batch waits at most this long for the rest of a step
+std::unique_ptr<StateBatch> gBatch;      // this process's, if it is an agent manager
+}  // namespace
+
+void StateBatch::start(ros::NodeHandle& pnh, const std::vector<int>& ids) {
+  gBatch.reset(new StateBatch(pnh, ids));
+}
+
+void StateBatch::stop() { gBatch.reset(); }
+
+StateBatch* StateBatch::local() { return gBatch.get(); }
+
+StateBatch::StateBatch(ros::NodeHandle& pnh, const std::vector<int>& ids)
+    : ids_(ids.begin(), ids.end()), pending_(boost::make_shared<variational_formation_msgs::AgentStates>()) {
+  // The outgoing queue of each subscriber holds as many batches as 250 steps of single states
+  // (more than twice the default window): a subscriber that is briefly busy loses nothing.
+  const uint32_t depth = static_cast<uint32_t>(std::max<std::size_t>(1000, 250 * ids_.size()));
+  ros::AdvertiseOptions options = ros::AdvertiseOptions::create<variational_formation_msgs::AgentStates>(
+      "states", depth, [this](const ros::SingleSubscriberPublisher& s) { onConnect(s); },
+      ros::SubscriberStatusCallback(), ros::VoidConstPtr(), nullptr);
+  pub_ = pnh.advertise(options);
+  pending_->states.reserve(ids_.size());
+  flusher_ = std::thread([this] { flushEvery5ms(); });
+}
+
+StateBatch::~StateBatch() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+  }
+  stop_.notify_all();
+  flusher_.join();
+}
+
+void StateBatch::flushEvery5ms() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (!stop_.wait_for(lock, std::chrono::duration<double>(kFlushAfter), [this] { return stopping_; })) {
+    lock.unlock();
+    flush();
+    lock.lock();
+  }
+}
+
+void StateBatch::add(const variational_formation_msgs::AgentState::ConstPtr& state) {
+  const int id = static_cast<int>(state->id);
+  if (ids_.count(id) == 0) return;
+  variational_formation::AgentStatesPtr full;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    newest_[id] = state;
+    pending_->states.push_back(*state);
+    if (pending_->states.size() < ids_.size()) return;
+    full = pending_;
+    pending_ = boost::make_shared<variational_formation_msgs::AgentStates>();
+    pending_->states.reserve(ids_.size());
+  }
+  pub_.publish(variational_formation::AgentStatesConstPtr(full));
+}
+
+void StateBatch::flush() {
+  variational_formation::AgentStatesPtr held;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (pending_->states.empty()) return;
+    held = pending_;
+    pending_ = boost::make_shared<variational_formation_msgs::AgentStates>();
+    pending_->states.reserve(ids_.size());
+  }
+  pub_.publish(variational_formation::AgentStatesConstPtr(held));
+}
+
+void StateBatch::onConnect(const ros::SingleSubscriberPublisher& subscriber) {
+  variational_formation_msgs::AgentStates newest;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& held : newest_) newest.states.push_back(*held.second);
+  }
+  if (!newest.states.empty()) subscriber.publish(newest);
+}
+
+namespace {
+std::unique_ptr<AgentThreads> gThreads;  // this process's, if it is an agent manager
+}  // namespace
+
+void AgentThreads::start(int threads) { gThreads.reset(new AgentThreads(threads)); }
+
+void AgentThreads::stop() { gThreads.reset(); }
+
+AgentThreads* AgentThreads::local() { return gThreads.get(); }
+
+AgentThreads::AgentThreads(int threads) {
+  for (int k = 0; k < std::max(1, threads); ++k) queues_.push_back(std::make_unique<ros::CallbackQueue>());
+  for (auto& q : queues_) {
+    threads_.emplace_back([this, queue = q.get()] {
+      while (!stopping_) queue->callAvailable(ros::WallDuration(0.1));
+    });
+  }
+}
+
+AgentThreads::~AgentThreads() { halt(); }
+
+void AgentThreads::halt() {
+  stopping_ = true;
+  for (auto& q : queues_) q->disable();  // wakes a thread waiting in callAvailable
+  for (std::thread& t : threads_) {
+    if (t.joinable()) t.join();
+  }
+}
+
+ros::CallbackQueue* AgentThreads::nextQueue() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return queues_[next_++ % queues_.size()].get();
+}
+
+std::vector<int> parseAgentIds(const std::string& list, const std::string& parameter) {
+  std::istringstream words(list);
+  std::vector<int> ids;
+  std::set<int> seen;
+  for (std::string w; words >> w;) {
+    std::size_t used = 0;
+    int id = -1;
+    try {
+      id = std::stoi(w, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != w.size() || id < 0) throw InvalidInput(parameter + ": '" + w + "' is not an agent id (an integer >= 0)");
+    if (!seen.insert(id).second) throw InvalidInput(parameter + ": agent " + w + " is listed twice");
+    ids.push_back(id);
+  }
+  if (ids.empty()) throw InvalidInput(parameter + ": no agent ids in '" + list + "'");
+  return ids;
+}
+
+std::vector<BatchSource> batchSources(const ros::NodeHandle& nh, const std::vector<std::string>& managers, int agents) {
+  std::vector<BatchSource> sources;
+  std::map<int, int> claims;
+  for (const std::string& m : managers) {
+    XmlRpc::XmlRpcValue value;
+    const ros::NodeHandle manager(nh, m);  // its private namespace: m is a full name
+    if (!manager.getParam("agents", value)) continue;  // a manager that does not batch
+    std::string list;
+    if (value.getType() == XmlRpc::XmlRpcValue::TypeInt) list = std::to_string(static_cast<int>(value));
+    if (value.getType() == XmlRpc::XmlRpcValue::TypeString) list = static_cast<std::string>(value);
+    BatchSource s{m, {}};
+    try {
+      for (int id : parseAgentIds(list, m + "/agents")) {
+        if (id < agents) s.ids.insert(id);
+      }
+    } catch (const InvalidInput&) {
+      continue;  // the manager itself refuses to start with it, saying why
+    }
+    for (int id : s.ids) ++claims[id];
+    sources.push_back(s);
+  }
+  for (BatchSource& s : sources) {
+    for (auto it = s.ids.begin(); it != s.ids.end();) it = claims[*it] > 1 ? s.ids.erase(it) : std::next(it);
+  }
+  return sources;
+}
+
+}  // namespace vf

@@ -1,0 +1,434 @@
+// The distributed protocol without a transport (core/protocol): the run referee, the whole-step
+// assembler and the recovery choice, first in the event sequences of failures that rostests
+// once found, then in seeded random interleavings of deliveries, repeats, reorderings, losses,
+// kills and restarts. Every run must record each state once, equal bit for bit to the
+// centralised run, and finish; a run that stalls must say what it waits for.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+#include <sstream>
+
+#include "protocol_world.hpp"
+#include "test_support.hpp"
+#include "variational_formation_core/protocol/timed_referee.hpp"
+#include "variational_formation/tools/make_scenario_cli.hpp"
+
+namespace vf {
+namespace {
+
+using test::Message;
+using test::World;
+
+Scenario shortScenario(const std::string& name, long steps) {
+  Scenario s = loadScenario(test::configPath(name));
+  s.steps = steps;
+  return s;
+}
+
+/// A scenario as `make_scenario ARGS` writes it.
+Scenario generated(std::vector<std::string> args) {
+  const std::string path = testing::TempDir() + "protocol_generated.yaml";
+  args.insert(args.begin(), "make_scenario");
+  args.insert(args.end(), {"--out", path});
+  std::vector<const char*> argv;
+  for (const std::string& a : args) argv.push_back(a.c_str());
+  std::ostringstream out, err;
+  EXPECT_EQ(runMakeScenarioCli(static_cast<int>(argv.size()), argv.data(), out, err), 0) << err.str();
+  return loadScenario(path);
+}
+
+/// Delivers everything in order, running the stall timers when nothing is in flight.
+/// @return false if the run stalled (20 timer rounds without a new step written).
+bool runInOrder(World& w, long maxRounds = 20) {
+  long idle = 0;
+  while (!w.finished() && !w.failed()) {
+    if (w.inFlight().empty()) {
+      const long before = w.writtenThrough();
+      w.stallTimers();
+      if (w.writtenThrough() == before && w.inFlight().empty() && ++idle > maxRounds) return false;
+      continue;
+    }
+    w.deliver(0);
+  }
+  while (!w.inFlight().empty()) w.deliver(0);  // the recorder's last steps
+  return true;
+}
+
+void expectComplete(const World& w, long steps) {
+  EXPECT_TRUE(w.finished()) << w.waitingFor();
+  EXPECT_EQ(w.writtenThrough(), steps) << w.waitingFor();
+  for (const std::string& v : w.violations()) ADD_FAILURE() << v;
+}
+
+// ---- the recovery choice and the buffers ----
+
+TEST(Recovery, AgentResumesFromTheNewestHolderAndTheFirstOnATie) {
+  using protocol::RecallAnswer;
+  EXPECT_EQ(protocol::chooseAgentResume({}), -1);
+  EXPECT_EQ(protocol::chooseAgentResume({{true, true, 0}, {false, true, 9}}), -1);  // step 0 or unanswered
+  EXPECT_EQ(protocol::chooseAgentResume({{true, true, 4}, {true, false, 9}, {true, true, 7}, {true, true, 7}}), 2);
+}
+
+TEST(Recovery, MonitorResumesAfterTheNewestProgressHeard) {
+  const auto r = protocol::chooseMonitorResume({{true, true, 11, 3}, {true, true, 19, -1}, {false, true, 50, 2}}, 8);
+  EXPECT_EQ(r.step, 20);
+  EXPECT_EQ(r.congruentSince, -1);
+  EXPECT_EQ(r.acceptUpTo, 20 + 8 + 2);
+  EXPECT_FALSE(protocol::chooseMonitorResume({{true, false, 5, 1}, {true, true, -1, -1}}, 8).resumes());
+}
+
+TEST(Recovery, MonitorAgainstTheAgentsOfARunThatIsOverNeitherResumesNorStartsOne) {
+  // Agent 1 heard the final progress (finished at step 1500); agent 0 only an earlier one.
+  const auto r = protocol::chooseMonitorResume({{true, true, 1100, 40}, {true, true, 1500, 40, true, true}}, 8);
+  EXPECT_TRUE(r.over);
+  EXPECT_TRUE(r.finished);
+  EXPECT_EQ(r.overAt, 1500);
+  EXPECT_FALSE(r.resumes());
+  const std::string line = protocol::describeOver(r);
+  EXPECT_NE(line.find("already over (it finished at step 1500)"), std::string::npos) << line;
+  EXPECT_EQ(line.find('\n'), std::string::npos);
+  // A failed run is over too; an unanswered call says nothing.
+  const auto failed = protocol::chooseMonitorResume({{true, true, 30, -1, true, false}}, 8);
+  EXPECT_TRUE(failed.over);
+  EXPECT_NE(protocol::describeOver(failed).find("it failed at step 30"), std::string::npos);
+  EXPECT_FALSE(protocol::chooseMonitorResume({{false, true, 30, -1, true, true}, {true, true, 12, -1}}, 8).over);
+  EXPECT_EQ(protocol::describeOver(protocol::chooseMonitorResume({{true, true, 12, -1}}, 8)), "");
+}
+
+TEST(Recovery, WindowIsCheckedAgainstTheRecorderBuffers) {
+  EXPECT_EQ(protocol::checkBuffers(100), "");
+  const long largest = protocol::maxWindow(protocol::RecorderBuffers());
+  EXPECT_EQ(protocol::checkBuffers(largest), "");
+  EXPECT_LE(protocol::recorderLead(largest), 1024);
+  const std::string line = protocol::checkBuffers(largest + 1);
+  EXPECT_NE(line.find("keeps only 1024 steps"), std::string::npos) << line;
+  EXPECT_EQ(line.find('\n'), std::string::npos);
+  EXPECT_NE(protocol::checkBuffers(50, {40, 1024}).find("queues hold 40"), std::string::npos);
+}
+
+// ---- the whole-step assembler ----
+
+TEST(StepAssembler, HandsOutWholeStepsInOrderOnce) {
+  protocol::StepAssembler<int, int, int> a(2, [](long k) { return k % 2 == 0; });
+  EXPECT_TRUE(a.addState(0, 1, 10));
+  EXPECT_TRUE(a.addState(1, 1, 11));
+  EXPECT_TRUE(a.addStatus(1, 100));
+  EXPECT_TRUE(a.takeWhole().empty());  // step 0 is not whole yet
+  EXPECT_FALSE(a.addMarkers(1, 5));    // step 1 needs no markers
+  EXPECT_TRUE(a.addState(0, 0, 0));
+  EXPECT_FALSE(a.addState(0, 0, 99));  // the first copy counts
+  EXPECT_TRUE(a.addState(1, 0, 1));
+  EXPECT_TRUE(a.addStatus(0, 50));
+  EXPECT_EQ(a.lacking(), "step 0: the markers");
+  EXPECT_TRUE(a.addMarkers(0, 7));
+  const auto whole = a.takeWhole();
+  ASSERT_EQ(whole.size(), 2u);
+  EXPECT_EQ(whole[0].step, 0);
+  EXPECT_EQ(whole[0].states, (std::vector<int>{0, 1}));
+  EXPECT_EQ(whole[0].markers, 7);
+  EXPECT_EQ(whole[1].status, 100);
+  EXPECT_EQ(a.handedOutThrough(), 1);
+  EXPECT_FALSE(a.addStatus(1, 100));  // republished: written once
+  EXPECT_EQ(a.lacking(), "step 2: agent 0's state, agent 1's state, the status, the markers");
+  EXPECT_EQ(protocol::stepOfStamp(0.30000000000000004, 0.1), 3);
+}
+
+TEST(StepAssembler, AWholeStepWaitsForWhatItsStatusCounts) {
+  // The recorder's rule (manoeuvre_faults flake): a status counts the commands issued before it,
+  // and its step is written only once the recorder holds that many, whichever came first.
+  protocol::StepAssembler<int, int, int> a(1, [](long) { return false; });
+  std::size_t held = 0;
+  const auto commandsHeld = [&held](const protocol::StepAssembler<int, int, int>::Step& s) {
+    return held >= static_cast<std::size_t>(s.status);
+  };
+  for (long k = 0; k < 3; ++k) {
+    ASSERT_TRUE(a.addState(0, k, 0));
+    ASSERT_TRUE(a.addStatus(k, k == 0 ? 0 : 1));  // steps 1 and 2 count one command
+  }
+  const auto first = a.takeWhole(commandsHeld);
+  ASSERT_EQ(first.size(), 1u);  // step 1 waits for the command list
+  EXPECT_EQ(a.handedOutThrough(), 0);
+  EXPECT_TRUE(a.takeWhole(commandsHeld).empty());
+  held = 1;
+  const auto rest = a.takeWhole(commandsHeld);
+  ASSERT_EQ(rest.size(), 2u);
+  EXPECT_EQ(rest[0].step, 1);
+  EXPECT_EQ(a.handedOutThrough(), 2);
+}
+
+// ---- the run referee, event by event ----
+
+TEST(LockstepReferee, ProgressGoesOutWhenAgentsMayWaitAtTheAllowedStep) {
+  // The throttling rule (commit a83a62b, "a throttling deadlock"): a progress goes out every
+  // quarter window only, but also whenever the agents may already wait at the allowed step;
+  // without that, agents that reached it idle until the window moved a whole quarter.
+  const Scenario s = shortScenario("square", 40);
+  test::Referee r(s, 8, true, false);
+  const auto offerStep = [&](long k) {
+    for (int i = 0; i < s.agentCount(); ++i) {
+      test::State st{i, k, std::vector<double>(2, 0.1 * i + k), std::vector<double>(2, 0.1 * i)};
+      ASSERT_EQ(r.offerState(i, st), FormationMonitor::Receipt::Accepted);
+    }
+    for (const auto& snap : r.takeCompleted()) r.keep(snap.metrics.step, snap.metrics.step);
+  };
+  offerStep(0);
+  EXPECT_FALSE(r.updateProgress(true));  // the recorder does not hold step 0 yet
+  r.recorderProgress(0, false);
+  ASSERT_TRUE(r.updateProgress(true));
+  EXPECT_EQ(r.progressNow().allowedStep, 8);
+  for (long k = 1; k <= 8; ++k) offerStep(k);  // the agents stop at 8
+  r.recorderProgress(1, false);                // allowed 9: less than a quarter window (2) more
+  ASSERT_TRUE(r.updateProgress(true)) << "agents wait at step 8 and no progress goes out";
+  EXPECT_EQ(r.progressNow().allowedStep, 9);
+  EXPECT_EQ(r.progressNow().completedStep, 1);
+  r.recorderProgress(2, false);
+  EXPECT_FALSE(r.updateProgress(true));  // allowed 10: not a quarter more, and nobody waits at 9 yet
+  offerStep(9);
+  EXPECT_TRUE(r.updateProgress(true));   // now they do
+  EXPECT_EQ(r.progressNow().allowedStep, 10);
+  r.recorderProgress(9, false);
+  ASSERT_TRUE(r.updateProgress(true));
+  EXPECT_EQ(r.progressNow().allowedStep, 17);
+  EXPECT_EQ(r.waitingFor("rec"), "step 10 of agent_0, agent_1, agent_2, agent_3");
+}
+
+TEST(LockstepReferee, StatesPastTheAllowedStepAndRepeatsAreRefused) {
+  const Scenario s = shortScenario("square", 40);
+  test::Referee r(s, 8, false, false);
+  test::State st{0, 1, {0.0, 0.0}, {0.0, 0.0}};
+  EXPECT_EQ(r.offerState(0, st), FormationMonitor::Receipt::ImpossibleStep);  // nothing allowed yet
+  st.step = 0;
+  EXPECT_EQ(r.offerState(0, st), FormationMonitor::Receipt::Accepted);
+  EXPECT_EQ(r.offerState(0, st), FormationMonitor::Receipt::Duplicate);
+  EXPECT_EQ(r.newest(0)->step, 0);
+  EXPECT_EQ(r.newest(1), nullptr);
+  r.fail("agent_1 ended");
+  EXPECT_TRUE(r.ended());
+  EXPECT_EQ(r.progressNow().reason, "agent_1 ended");
+  EXPECT_FALSE(r.updateProgress(true));
+}
+
+TEST(TimedReferee, StartsOnceEveryAgentIsHeardAndKeepsTheNewestState) {
+  const Scenario s = shortScenario("square", 3);
+  protocol::TimedReferee<test::State> r(s, 1.0);
+  std::string why;
+  EXPECT_FALSE(r.offerState(0, {0, 0, {0.0}, {0.0}}, 0.0, why));
+  EXPECT_NE(why.find("wrong dimension"), std::string::npos);
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE(r.offerState(i, {i, 2, {1.0 * i, 0.0}, {1.0 * i, 0.0}}, 0.0, why));
+  EXPECT_TRUE(r.tick(0.1).empty());  // agent 3 not heard
+  EXPECT_EQ(r.unheard(), std::vector<int>{3});
+  ASSERT_TRUE(r.offerState(3, {3, 3, {0.0, 1.0}, {0.0, 1.0}}, 0.2, why));
+  ASSERT_TRUE(r.offerState(3, {3, 1, {9.0, 9.0}, {9.0, 9.0}}, 0.5, why));  // older: ignored while fresh
+  ASSERT_EQ(r.tick(0.5).size(), 1u);
+  EXPECT_EQ(r.newest(3)->step, 3);
+  EXPECT_DOUBLE_EQ(r.dataAge(), 0.5);
+  EXPECT_EQ(r.silent(1.1), (std::vector<int>{0, 1, 2}));
+  ASSERT_TRUE(r.offerState(3, {3, 1, {9.0, 9.0}, {9.0, 9.0}}, 1.3, why));  // a respawned agent, old state stale
+  EXPECT_EQ(r.newest(3)->step, 1);
+  EXPECT_FALSE(r.finished());
+  for (int i = 0; i < 4; ++i) ASSERT_TRUE(r.offerState(i, {i, 3, {1.0 * i, 0.0}, {1.0 * i, 0.0}}, 1.4, why));
+  r.tick(1.5);
+  EXPECT_TRUE(r.finished());
+}
+
+// ---- whole runs, event by event ----
+
+TEST(ProtocolRun, InOrderDeliveryFinishesWithEveryStateOnce) {
+  World w(shortScenario("square", 30), 4, 3);
+  ASSERT_TRUE(runInOrder(w)) << w.waitingFor();
+  expectComplete(w, 30);
+}
+
+TEST(ProtocolRun, RepeatsAtStartUpAreRecordedOnce) {
+  World w(shortScenario("hexagon", 20), 8, 1);
+  // Every first message delivered twice (a latched state, and the same state again after a reconnect).
+  for (std::size_t m = 0; m < w.inFlight().size();) {
+    w.deliver(m, true);
+    w.deliver(m);
+  }
+  ASSERT_TRUE(runInOrder(w)) << w.waitingFor();
+  expectComplete(w, 20);
+}
+
+TEST(ProtocolRun, CatchUpFromHistoriesMakesGoodALostState) {
+  World w(shortScenario("square", 20), 4, 1);
+  // The monitor and the recorder lose agent 2's step 3 (their connections were coming up): it
+  // comes from agent 2's history.
+  while (!w.inFlight().empty()) {
+    const Message& msg = w.inFlight()[0];
+    if (msg.kind == Message::Kind::State && msg.from == 2 && msg.to < 0 && msg.state.step == 3) {
+      w.lose(0);
+    } else {
+      w.deliver(0);
+    }
+    if (w.referee()->completedStep() >= 2) break;
+  }
+  for (std::size_t m = 0; m < w.inFlight().size();) {
+    const Message& msg = w.inFlight()[m];
+    if (msg.kind == Message::Kind::State && msg.from == 2 && msg.to < 0 && msg.state.step == 3) {
+      w.lose(m);
+    } else {
+      ++m;
+    }
+  }
+  ASSERT_TRUE(runInOrder(w)) << w.waitingFor();
+  expectComplete(w, 20);
+}
+
+TEST(ProtocolRun, IncarnationKilledAgainBeforeTheMonitorGotItsStepComesFromItsNeighbours) {
+  World w(shortScenario("square", 20), 4, 1);
+  std::mt19937 rng(1);
+  // Run to step 5 of agent 1, with everything to the monitor and recorder from agent 1 lost.
+  const auto deliverUntil = [&](long step) {
+    while (!w.inFlight().empty() && w.referee()->completedStep() < step) {
+      const Message& msg = w.inFlight()[0];
+      if (msg.kind == Message::Kind::State && msg.from == 1 && msg.to < 0) {
+        w.lose(0);
+      } else {
+        w.deliver(0);
+      }
+    }
+  };
+  deliverUntil(3);
+  w.killAgent(1, rng, 1.0);
+  w.restartAgent(1);  // resumes from its neighbours
+  deliverUntil(3);
+  w.killAgent(1, rng, 1.0);  // and dies again: its neighbours alone hold its newest steps
+  w.restartAgent(1);
+  ASSERT_TRUE(runInOrder(w)) << w.waitingFor();
+  expectComplete(w, 20);
+}
+
+TEST(ProtocolRun, MonitorRestartWithIncompleteStepsResumesExactly) {
+  World w(shortScenario("hexagon", 24), 6, 2);
+  for (int k = 0; k < 150 && !w.inFlight().empty(); ++k) w.deliver(w.inFlight().size() / 2);
+  ASSERT_LT(w.referee()->completedStep(), 24);
+  w.killMonitor();
+  for (int k = 0; k < 30 && !w.inFlight().empty(); ++k) w.deliver(0);  // the agents go on meanwhile
+  w.restartMonitor();
+  ASSERT_TRUE(runInOrder(w)) << w.waitingFor();
+  expectComplete(w, 24);
+}
+
+TEST(ProtocolRun, RecorderThatFallsBehindHoldsTheAgentsWithinTheWindow) {
+  const long window = 8;
+  World w(shortScenario("square", 60), window, 1);
+  // Everything but the recorder's messages first: the agents run until the window stops them.
+  long idle = 0, lead = 0;
+  while (!w.finished() && idle < 1000) {
+    std::size_t m = 0;
+    while (m < w.inFlight().size() && w.inFlight()[m].to == Message::Recorder) ++m;
+    if (m == w.inFlight().size()) {
+      if (w.inFlight().empty()) break;
+      m = 0;  // only the recorder's are left: it takes one
+      ++idle;
+    }
+    w.deliver(m);
+    // The gate: the agents never compute past the recorder's written step plus the window.
+    ASSERT_LE(w.newestAgentStep(), w.writtenThrough() + window);
+    lead = std::max(lead, w.newestAgentStep() - w.writtenThrough());
+  }
+  ASSERT_TRUE(runInOrder(w)) << w.waitingFor();
+  expectComplete(w, 60);
+  EXPECT_EQ(lead, window) << "the recorder never fell a whole window behind";
+  EXPECT_LE(w.maxPendingSteps(), protocol::recorderLead(window));
+}
+
+// ---- seeded random interleavings ----
+
+struct Chances {
+  double repeat = 0.05, lose = 0.03, killAgent = 0.004, killMonitor = 0.001, restart = 0.05, timers = 0.02;
+  /// Events after a restart before the next kill; and the stall timers must have run in between:
+  /// one fault at a time, each recovered (see FasterFaults below for what happens otherwise).
+  long settle = 50;
+};
+
+/// One seeded interleaving. @return "" or what went wrong.
+std::string randomRun(const Scenario& s, long window, unsigned seed, const Chances& c) {
+  World w(s, window, 1 + seed % 3);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<int> dead;
+  bool monitorDead = false;
+  long events = 0, idle = 0, lastWritten = -1, settledAt = 0;
+  bool timersRan = true;
+  while (!w.finished() && !w.failed()) {
+    if (++events > 400000) return "no end after 400000 events; waiting for " + w.waitingFor();
+    if (!w.violations().empty()) return w.violations().front();
+    const double x = u(rng);
+    if (monitorDead && (x < c.restart || w.inFlight().empty())) {
+      w.restartMonitor();
+      monitorDead = false;
+      settledAt = events + c.settle;
+      timersRan = c.settle == 0;
+    } else if (!dead.empty() && (x < c.restart || w.inFlight().empty())) {
+      w.restartAgent(dead.back());
+      dead.pop_back();
+      settledAt = events + c.settle;
+      timersRan = c.settle == 0;
+    } else if (x < c.killAgent && dead.empty() && !monitorDead && events > settledAt && timersRan) {
+      const int i = static_cast<int>(rng() % static_cast<unsigned>(w.agentCount()));
+      if (w.agentAlive(i)) {
+        w.killAgent(i, rng, 0.5);
+        dead.push_back(i);
+      }
+    } else if (x < c.killAgent + c.killMonitor && dead.empty() && !monitorDead && events > settledAt && timersRan) {
+      w.killMonitor();
+      monitorDead = true;
+    } else if (w.inFlight().empty() || x < c.killAgent + c.killMonitor + c.timers) {
+      w.stallTimers();
+      timersRan = true;
+      if (w.writtenThrough() == lastWritten && w.inFlight().empty() && ++idle > 50) {
+        return "stalled at step " + std::to_string(lastWritten) + "; waiting for " + w.waitingFor();
+      }
+    } else {
+      const std::size_t m = rng() % w.inFlight().size();
+      const Message& msg = w.inFlight()[m];
+      const bool losable = msg.kind == Message::Kind::State || msg.kind == Message::Kind::Status ||
+                           msg.kind == Message::Kind::Markers;
+      const double y = u(rng);
+      if (losable && y < c.lose) {
+        w.reconnect(m);
+      } else {
+        w.deliver(m, y > 1.0 - c.repeat);
+      }
+    }
+    if (w.writtenThrough() != lastWritten) idle = 0;
+    lastWritten = w.writtenThrough();
+  }
+  if (w.failed()) return "the run failed: " + w.failure();
+  while (!w.inFlight().empty()) w.deliver(0);
+  if (w.writtenThrough() != s.steps) return "finished with steps up to " + std::to_string(w.writtenThrough()) + " written";
+  return w.violations().empty() ? "" : w.violations().front();
+}
+
+TEST(ProtocolRandom, SeededInterleavingsRecordEveryStateOnceExactly) {
+  // The shipped formations, and generated rings and a grid as make_scenario builds them.
+  std::vector<std::pair<Scenario, long>> cases;  // scenario, window
+  for (const char* name : {"square", "hexagon", "tetrahedron", "grid24"}) cases.push_back({shortScenario(name, 12), 4});
+  cases[1].second = 1;
+  cases[2].second = 9;
+  cases.push_back({generated({"--shape", "ring", "--agents", "9", "--chords", "1", "--steps", "12"}), 3});
+  cases.push_back({generated({"--shape", "henneberg", "--agents", "7", "--dimension", "3", "--steps", "12"}), 5});
+  long interleavings = 0;
+  const unsigned runs = 500;  // per formation
+  for (std::size_t c = 0; c < cases.size(); ++c) {
+    for (unsigned seed = 1; seed <= runs; ++seed) {
+      const unsigned full = static_cast<unsigned>(c) * 100000u + seed;
+      if (std::getenv("PROTOCOL_SEED") && std::to_string(full) != std::getenv("PROTOCOL_SEED")) continue;
+      const std::string failure = randomRun(cases[c].first, cases[c].second, full, Chances());
+      ++interleavings;
+      if (!failure.empty()) {
+        ADD_FAILURE() << "seed " << full << " (" << cases[c].first.name << ", window " << cases[c].second
+                      << "): " << failure;
+        std::printf("protocol: failing seed %u\n", full);
+      }
+    }
+  }
+  std::printf("protocol: %ld seeded interleavings over %zu formations\n", interleavings, cases.size());
+}
+
+}  // namespace
+}  // namespace vf

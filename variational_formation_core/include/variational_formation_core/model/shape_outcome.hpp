@@ -1,0 +1,88 @@
+#pragma once
+
+#include <string>
+
+#include "variational_formation_core/model/formation.hpp"
+
+namespace vf {
+
+/// What a configuration says about the shape (doc/scenarios.md, "Folded shapes and mirror images").
+struct ShapeFindings {
+  double shapeError = 0.0;     ///< Formation::shapeError, over all pairs [m]
+  double maxEdgeError = 0.0;   ///< Formation::maxDistanceError, over the edges [m]
+  bool congruent = false;      ///< every pair within tolerance, every agent slow (as given)
+  bool edgesConverged = false; ///< every edge within tolerance, every agent slow
+  bool mirrored = false;       ///< congruent, and with the mirror image of the desired shape (isMirrorImage)
+};
+
+/**
+ * The findings at one configuration q [m] with velocities v relative to the commanded motion
+ * [m/s], against s d_ij (s = scale). `congruent` is the caller's congruence test (a
+ * CongruenceTracker's, the same as congruenceSlack >= 0 with all speeds below maxSpeed). The
+ * mirror test runs only on a congruent shape. O(n^2) for the shape error, O(n + |E|) without it
+ * (withShapeError false: shapeError is NaN).
+ */
+ShapeFindings findShape(const Formation& formation, const Positions& q, const Velocities& v, double scale,
+                        bool congruent, double tolerance, double maxSpeed, bool withShapeError = true);
+
+/**
+ * Whether a run measures the O(n^2) shape error at `step`: at most a 200-agent cost per step on
+ * average, so every step up to 200 agents, every ceil((n/200)^2) steps beyond, and always at the
+ * last step (lastStep <= 0: unbounded). The monitor and `simulate`'s metrics use this one rule.
+ */
+bool shapeErrorMeasuredAt(long step, int agents, long lastStep);
+
+/// The three endings of a run.
+enum class ShapeVerdict { DesiredShape, OtherShape, NotConverged };
+
+struct ShapeOutcome {
+  ShapeVerdict verdict = ShapeVerdict::NotConverged;
+  ShapeFindings findings;
+  long convergedStep = -1;  ///< first step of the final stretch in the desired shape, -1 if none
+  /// Why the run stopped short of the shape under a safety filter ("blocked: agents 2, 4",
+  /// BlockedDetector::description()), or empty; set by blockedShapeOutcome.
+  std::string blocked;
+  /// "converged to the desired shape at step K (t = T s)",
+  /// "edges converged but the shape is not the desired one (shape error E m)" (with "its mirror
+  /// image; " before the shape error for a mirror image), or
+  /// "not converged (final max distance error E m)".
+  std::string line;
+};
+
+/// The outcome of a run that the safety filter blocked: not converged, with line
+/// "not converged (blocked: agents 2, 4)"; the findings are kept.
+ShapeOutcome blockedShapeOutcome(ShapeOutcome outcome, const std::string& blocked);
+
+/**
+ * The verdict at the last step: the desired shape if congruent and not mirrored (or mirrored
+ * with mirrorAllowed); another shape if every edge converged; else not converged.
+ * @param congruentSince first step of the congruent stretch holding at the last step (-1 if
+ * none); @param timeStep h [s].
+ */
+ShapeOutcome shapeOutcome(const ShapeFindings& findings, long congruentSince, bool mirrorAllowed, double timeStep);
+
+/**
+ * Follows a run step by step (congruence at amortised O(n) per step, CongruenceTracker) and
+ * gives its ShapeOutcome at the last observed step; `simulate`'s final line.
+ */
+class ShapeTracker {
+ public:
+  ShapeTracker(const Formation& formation, bool mirrorAllowed, double tolerance = 0.01, double maxSpeed = 0.1);
+  /// Step k: q [m], v relative to the commanded motion [m/s], commanded scale s.
+  void observe(long step, const Positions& q, const Velocities& v, double scale);
+  /// The outcome at the last observed step. @param timeStep h [s].
+  ShapeOutcome outcome(double timeStep) const;
+
+ private:
+  const Formation& formation_;
+  bool mirrorAllowed_;
+  double tolerance_, maxSpeed_;
+  CongruenceTracker congruence_;
+  long congruentSince_ = -1;
+  bool congruent_ = false;
+  Positions q_;
+  Velocities v_;
+  double scale_ = 1.0;
+};
+
+}  // namespace vf

@@ -1,0 +1,292 @@
+#pragma once
+
+#include <algorithm>
+#include <deque>
+#include <exception>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "variational_formation_core/agents/lockstep_agent.hpp"
+#include "variational_formation_core/protocol/command_desk.hpp"
+#include "variational_formation_core/protocol/progress.hpp"
+
+namespace vf::protocol {
+
+/**
+ * One lockstep agent's side of the protocol without a transport (doc/protocol.md, "The agent"):
+ * the gates, the histories and the failures around a LockstepAgent, which does all the maths.
+ * Each event (a state on a topic, the monitor's progress, its command list, a wake-up) goes to
+ * step(), which returns a Ready: what to do, in order. The agent node (and the tests' simulated
+ * network) only moves messages between its transport and this class.
+ *
+ * - Flow gate: it computes step k + 1 only while k < the newest allowed step it heard, once it
+ *   holds every command the newest progress counts, and never after the run is over or it failed.
+ * - Pacing: with a real-time factor r > 0, step k + 1 is due (k + 1 - k0) h / r [s] after the
+ *   first step it computed (from k0), on the caller's clock.
+ * - Histories: its published states, and the neighbours' states it accepted, after the newest
+ *   completed step it heard (served to a restarted monitor or recorder, `~history`).
+ * - Failures: a step that is not finite is undone and its last good state published with the
+ *   reason; so is a listed command it cannot apply. Either ends its stepping; the monitor ends
+ *   the run.
+ *
+ * StatePtr points to the caller's state message (fields id, step, position, previous_position);
+ * it is built by `make` and kept as it is, so histories serve exactly what was published.
+ * ProgressMsg is the caller's progress message, kept as it came for `~history`.
+ */
+template <class StatePtr, class ProgressMsg>
+class AgentProtocol {
+ public:
+  /// Builds the state message of the agent's current step (`failure`: "" or why it ends the run).
+  using MakeState = std::function<StatePtr(const LockstepAgent& agent, const std::string& failure)>;
+  /// The caller's clock [s] (only differences are used; needed with a real-time factor).
+  using Clock = std::function<double()>;
+
+  /// What to do after an event, in this order.
+  struct Ready {
+    std::vector<StatePtr> publish;  ///< states to publish, oldest first (already in the history)
+    std::string failed;             ///< "" or why this agent ends the run (the last state says it too)
+    std::string dropped;            ///< "" or what was dropped and why
+    std::string over;               ///< "" or: the run just ended (a line to log)
+    bool wakeWhenSensed = false;    ///< waits for states: wake (Wake) when the shared board holds the step
+    double wakeAfter = -1.0;        ///< >= 0: the pacing timer; wake (Wake) after this many seconds
+  };
+
+  /// A state on agent `topic`'s topic (already checked to come from its owner).
+  struct StateArrived {
+    int topic;
+    StatePtr state;
+  };
+  /// The monitor's progress: what the agent reads of it, and the message itself.
+  struct ProgressArrived {
+    AgentProgress progress;
+    ProgressMsg message;
+  };
+  /// The monitor's list of issued commands: `listed` entries, entry(k) the k-th (0-based).
+  struct CommandsArrived {
+    long listed;
+    std::function<IssuedCommand(long)> entry;
+  };
+  /// The pacing timer or the shared board says the agent may go on.
+  struct Wake {};
+
+  /// @param realTimeFactor r (>= 0; 0: as fast as possible), validated by the caller.
+  /// @param earliness how early a paced step may start [s] (>= 0): one due sooner goes now, so
+  ///        that a pacer releasing a process's agents together never waits for another's due.
+  AgentProtocol(LockstepAgent agent, MakeState make, double realTimeFactor = 0.0, Clock clock = Clock(),
+                double earliness = 0.0)
+      : agent_(std::move(agent)),
+        make_(std::move(make)),
+        clock_(std::move(clock)),
+        realTimeFactor_(realTimeFactor),
+        earliness_(earliness),
+        neighbourHistory_(agent_.neighbourIds().size()) {}
+
+  /// Crash recovery, before start(): resumes the agent at `step` (LockstepAgent::resume).
+  /// @throws InvalidInput if the state does not fit; the agent is then unchanged.
+  void resume(long step, const std::vector<double>& position, const std::vector<double>& previousPosition) {
+    agent_.resume(step, position, previousPosition);
+  }
+  /// The first state (step 0 or the recovered one).
+  Ready start() {
+    Ready r;
+    publishNow(r);
+    return r;
+  }
+
+  Ready step(const StateArrived& e) {
+    Ready r;
+    try {
+      const auto& msg = *e.state;
+      const long sender = static_cast<long>(msg.id) == e.topic ? e.topic : -1;
+      const auto receipt = agent_.receive(sender, msg.step, msg.position, msg.previous_position);
+      if (receipt == LockstepAgent::Receipt::Accepted) {
+        const std::vector<int>& ids = agent_.neighbourIds();
+        const auto k = static_cast<std::size_t>(std::find(ids.begin(), ids.end(), e.topic) - ids.begin());
+        if (k < ids.size()) neighbourHistory_[k].push_back(e.state);
+        advance(r);
+      } else if (receipt != LockstepAgent::Receipt::Duplicate) {
+        r.dropped = "a state from agent_" + std::to_string(e.topic) + " (step " + std::to_string(msg.step) +
+                    "): " + LockstepAgent::describe(receipt);
+      }
+    } catch (const std::exception& ex) {
+      r.dropped = std::string("a state: ") + ex.what();
+    }
+    return r;
+  }
+
+  Ready step(const ProgressArrived& e) {
+    Ready r;
+    // Once its run is over, an agent keeps that run's final word: a monitor started later (which
+    // says that the run is over) does not change it.
+    if (exitStatus_ >= 0) return r;
+    const Progress& p = e.progress.progress;
+    if (!hasProgress_ || p.completedStep >= heardCompleted_) {
+      lastProgress_ = e.message;
+      heardCompleted_ = p.completedStep;
+      hasProgress_ = true;
+      trimHistories(p.completedStep);
+    }
+    if (over(p)) {
+      // Stay up, idle: a respawning agent that exited would only be restarted.
+      const bool finished = p.state == Progress::State::Finished;
+      r.over = "the run is over at step " + std::to_string(agent_.step()) + " (" +
+               (finished ? std::string("finished") : "failed: " + p.reason) + "); idle until shut down";
+      exitStatus_ = finished ? 0 : 1;
+    } else {
+      allowedStep_ = std::max(allowedStep_, p.allowedStep);
+      commandsCounted_ = e.progress.commands;
+      advance(r);
+    }
+    return r;
+  }
+
+  Ready step(const CommandsArrived& e) {
+    Ready r;
+    while (failure_.empty() && commandsHeld_ < e.listed) {
+      const IssuedCommand c = e.entry(commandsHeld_);
+      std::string error;
+      const LockstepAgent::CommandReceipt receipt = agent_.receiveCommand(c.first, c.second, &error);
+      if (receipt != LockstepAgent::CommandReceipt::Accepted) {
+        // The monitor checked it and stamped it at a step no agent had passed: this cannot be
+        // made exact any more, so the run ends, saying why.
+        fail(r, "command " + std::to_string(commandsHeld_ + 1) + " (from step " + std::to_string(c.first) +
+                    ") refused at step " + std::to_string(agent_.step()) + ": " +
+                    (receipt == LockstepAgent::CommandReceipt::Late ? std::string("it came after that step") : error));
+        return r;
+      }
+      ++commandsHeld_;
+    }
+    advance(r);
+    return r;
+  }
+
+  Ready step(const Wake&) {
+    Ready r;
+    advance(r);
+    return r;
+  }
+
+  /// What it waits for, in words. @param monitor the monitor's node name.
+  std::string waitingFor(const std::string& monitor) const {
+    if (!failure_.empty()) return "the monitor to end the run (" + failure_ + ")";
+    if (agent_.finished()) return "the monitor to end the run (last step " + std::to_string(agent_.step()) + " done)";
+    if (agent_.step() >= allowedStep_) {
+      return allowedStep_ == 0 ? "the monitor " + monitor + " to start the run (it waits for every participant)"
+                               : "the monitor " + monitor + " to allow step " + std::to_string(agent_.step() + 1) +
+                                     " (flow control: it or the recorder is behind)";
+    }
+    if (commandsHeld_ < commandsCounted_) {
+      return "command " + std::to_string(commandsHeld_ + 1) + " of " + std::to_string(commandsCounted_) +
+             " on the monitor's latched `command`";
+    }
+    std::string missing;
+    const auto add = [&missing](int j) { missing += (missing.empty() ? "" : ", ") + std::string("agent_") + std::to_string(j); };
+    for (int j : agent_.neighbourIds()) {
+      if (!agent_.holdsNeighbourStep(j)) add(j);
+    }
+    if (missing.empty()) {  // with safety: every agent's state at the step (doc/distributed.md, "Sensing")
+      for (int j : agent_.missingSensed(5)) add(j);
+      if (!missing.empty()) missing += " (sensing)";
+    }
+    return missing.empty() ? "its pacing timer" : "the state at step " + std::to_string(agent_.step()) + " of " + missing;
+  }
+
+  const LockstepAgent& agent() const { return agent_; }
+  /// The held states of agent `id` after the newest completed step heard: its own published ones
+  /// (id = this agent) or a neighbour's accepted ones; nullptr for another agent.
+  const std::deque<StatePtr>* history(int id) const {
+    if (id == agent_.id()) return &history_;
+    const std::vector<int>& ids = agent_.neighbourIds();
+    const auto k = static_cast<std::size_t>(std::find(ids.begin(), ids.end(), id) - ids.begin());
+    return k < ids.size() ? &neighbourHistory_[k] : nullptr;
+  }
+  bool hasProgress() const { return hasProgress_; }
+  /// The newest progress heard (by completed step); a default message before any.
+  const ProgressMsg& lastProgress() const { return lastProgress_; }
+  /// -1 while the run goes on; 0 once the monitor said it finished, 1 failed.
+  int exitStatus() const { return exitStatus_; }
+  const std::string& failure() const { return failure_; }
+  /// Clock time [s] of the newest step computed; < 0 before any.
+  double lastStepAt() const { return lastStepAt_; }
+  long allowedStep() const { return allowedStep_; }
+  long commandsHeld() const { return commandsHeld_; }
+
+ private:
+  /// Computes every step the gates allow (the flow gate is this loop's condition).
+  void advance(Ready& r) {
+    while (exitStatus_ < 0 && failure_.empty() && !agent_.finished() && agent_.step() < allowedStep_ &&
+           commandsHeld_ >= commandsCounted_) {
+      if (!agent_.ready()) {
+        r.wakeWhenSensed = true;
+        return;
+      }
+      const double now = clock_ ? clock_() : 0.0;
+      if (!started_) {
+        started_ = true;
+        startedAt_ = now;
+        startStep_ = agent_.step();
+      }
+      if (realTimeFactor_ > 0.0) {
+        // Step k + 1 is due (k + 1 - k0) h / r after the start at step k0.
+        const double due = static_cast<double>(agent_.step() + 1 - startStep_) * agent_.scenario().timeStep / realTimeFactor_;
+        const double wait = due - (now - startedAt_);
+        if (wait > earliness_) {
+          r.wakeAfter = wait;
+          return;
+        }
+      }
+      agent_.advance();
+      if (!agent_.finite()) {
+        // Never publish a non-finite state: report the divergence with the last good one, and
+        // let the monitor end the run (doc/distributed.md).
+        const std::string why = "step " + std::to_string(agent_.step()) + " is not finite (the run diverged)";
+        agent_.undo();
+        fail(r, why);
+        return;
+      }
+      publishNow(r);
+      lastStepAt_ = now;
+    }
+  }
+  void fail(Ready& r, const std::string& why) {
+    failure_ = why;
+    r.failed = why;
+    publishNow(r);
+  }
+  void publishNow(Ready& r) {
+    StatePtr s = make_(agent_, failure_);
+    history_.push_back(s);
+    r.publish.push_back(std::move(s));
+  }
+  void trimHistories(long completed) {
+    while (!history_.empty() && history_.front()->step <= completed) history_.pop_front();
+    for (auto& held : neighbourHistory_) {
+      while (!held.empty() && held.front()->step <= completed) held.pop_front();
+    }
+  }
+
+  LockstepAgent agent_;
+  MakeState make_;
+  Clock clock_;
+  double realTimeFactor_;
+  double earliness_;  // [s]
+  std::deque<StatePtr> history_;  // published states after the newest completed step heard
+  // Neighbours' states accepted after that step, indexed like neighbourIds(): a state of an
+  // incarnation that died may exist nowhere else (doc/distributed.md, recovery).
+  std::vector<std::deque<StatePtr>> neighbourHistory_;
+  ProgressMsg lastProgress_{};
+  bool hasProgress_ = false;
+  long heardCompleted_ = -1;
+  long allowedStep_ = 0;
+  long commandsHeld_ = 0;     // commands of the monitor's list applied
+  long commandsCounted_ = 0;  // commands the newest progress counts: the agent steps only once it holds them
+  bool started_ = false;
+  double startedAt_ = 0.0, lastStepAt_ = -1.0;
+  long startStep_ = 0;
+  int exitStatus_ = -1;
+  std::string failure_;
+};
+
+}  // namespace vf::protocol

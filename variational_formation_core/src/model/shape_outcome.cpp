@@ -1,0 +1,81 @@
+#include "variational_formation_core/model/shape_outcome.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "variational_formation_core/model/rigid_fit.hpp"
+
+namespace vf {
+
+ShapeFindings findShape(const Formation& formation, const Positions& q, const Velocities& v, double scale,
+                        bool congruent, double tolerance, double maxSpeed, bool withShapeError) {
+  ShapeFindings f;
+  f.shapeError = withShapeError ? formation.shapeError(q, scale) : std::numeric_limits<double>::quiet_NaN();
+  f.maxEdgeError = formation.maxDistanceError(q, scale);
+  f.congruent = congruent;
+  f.edgesConverged = formation.allSlowerThan(v, maxSpeed) && formation.edgesWithin(q, tolerance, scale);
+  // A congruent shape cannot change hands without passing through a flat one, which is not
+  // congruent: while it stays congruent this answer holds.
+  f.mirrored = congruent && isMirrorImage(q, formation.desiredShape(), tolerance);
+  return f;
+}
+
+ShapeOutcome blockedShapeOutcome(ShapeOutcome outcome, const std::string& blocked) {
+  outcome.verdict = ShapeVerdict::NotConverged;
+  outcome.convergedStep = -1;
+  outcome.blocked = blocked;
+  outcome.line = "not converged (" + blocked + ")";
+  return outcome;
+}
+
+bool shapeErrorMeasuredAt(long step, int agents, long lastStep) {
+  const long every = static_cast<long>(std::ceil(std::pow(agents / 200.0, 2)));
+  return every <= 1 || step % every == 0 || (lastStep > 0 && step == lastStep);
+}
+
+ShapeOutcome shapeOutcome(const ShapeFindings& findings, long congruentSince, bool mirrorAllowed, double timeStep) {
+  ShapeOutcome o;
+  o.findings = findings;
+  char text[200];
+  if (findings.congruent && (!findings.mirrored || mirrorAllowed)) {
+    o.verdict = ShapeVerdict::DesiredShape;
+    o.convergedStep = congruentSince;
+    std::snprintf(text, sizeof text, "converged to the desired shape at step %ld (t = %.3f s)%s", congruentSince,
+                  congruentSince * timeStep, findings.mirrored ? ", its mirror image (mirror: allowed)" : "");
+  } else if (findings.edgesConverged) {
+    o.verdict = ShapeVerdict::OtherShape;
+    std::snprintf(text, sizeof text, "edges converged but the shape is not the desired one (%sshape error %.3g m)",
+                  findings.mirrored ? "its mirror image; " : "", findings.shapeError);
+  } else {
+    std::snprintf(text, sizeof text, "not converged (final max distance error %.3g m)", findings.maxEdgeError);
+  }
+  o.line = text;
+  return o;
+}
+
+ShapeTracker::ShapeTracker(const Formation& formation, bool mirrorAllowed, double tolerance, double maxSpeed)
+    : formation_(formation),
+      mirrorAllowed_(mirrorAllowed),
+      tolerance_(tolerance),
+      maxSpeed_(maxSpeed),
+      congruence_(tolerance, maxSpeed) {}
+
+void ShapeTracker::observe(long step, const Positions& q, const Velocities& v, double scale) {
+  congruent_ = congruence_.check(formation_, q, v, scale);
+  if (!congruent_) {
+    congruentSince_ = -1;
+  } else if (congruentSince_ < 0) {
+    congruentSince_ = step;
+  }
+  q_ = q;
+  v_ = v;
+  scale_ = scale;
+}
+
+ShapeOutcome ShapeTracker::outcome(double timeStep) const {
+  const ShapeFindings f = findShape(formation_, q_, v_, scale_, congruent_, tolerance_, maxSpeed_);
+  return shapeOutcome(f, congruentSince_, mirrorAllowed_, timeStep);
+}
+
+}  // namespace vf
