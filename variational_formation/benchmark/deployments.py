@@ -75,7 +75,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--runs", type=int, default=40)
     parser.add_argument("--graph", action="append", help="make_scenario --graph value, repeatable (default: complete and knn)")
-    parser.add_argument("--bin", default=os.path.join(REPO, ".ws", "devel", "lib", "variational_formation"))
+    parser.add_argument("--bin", default=os.path.join(os.path.dirname(REPO), ".ws", "devel", "lib", "variational_formation"))
     parser.add_argument("--keep", help="keep the scenarios and trajectories in this folder")
     args = parser.parse_args()
     simulate, make_scenario = tool(args.bin, "simulate"), tool(args.bin, "make_scenario")

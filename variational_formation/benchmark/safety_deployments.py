@@ -26,7 +26,7 @@ import numpy as np
 import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-DEFAULT_BIN = os.path.join(HERE, "..", ".ws", "devel", "lib", "variational_formation")
+DEFAULT_BIN = os.path.join(HERE, "..", "..", ".ws", "devel", "lib", "variational_formation")
 R_MIN = 0.25
 # A disc and a box inside the deployment square (centred on the shape's centroid, the origin).
 OBSTACLES = "obstacles:\n  - {center: [0.3, 0.2], radius: 0.3}\n  - {min: [-1.4, -0.9], max: [-1.1, -0.3]}\n"

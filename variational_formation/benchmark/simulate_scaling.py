@@ -51,7 +51,7 @@ def main():
     parser.add_argument("agents", nargs="*", type=int, default=[100, 1000, 10000])
     parser.add_argument("--steps", type=int, default=200)
     parser.add_argument("--simulate", default=os.path.join(os.environ.get("VF_WS", os.path.join(
-        os.path.dirname(os.path.abspath(__file__)), "..", ".ws")), "devel", "lib", "variational_formation", "simulate"))
+        os.path.dirname(os.path.abspath(__file__)), "..", "..", ".ws")), "devel", "lib", "variational_formation", "simulate"))
     args = parser.parse_args()
     if any(n < 5 for n in args.agents) or args.steps < 2:
         sys.exit("simulate_scaling: needs agent counts >= 5 and --steps >= 2")

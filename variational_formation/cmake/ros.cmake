@@ -17,9 +17,9 @@ target_sources(variational_formation_ros PRIVATE src/ros/lockstep_monitor.cpp sr
 add_dependencies(variational_formation_ros ${PROJECT_NAME}_gencfg)
 # catkin's include path is given to each ROS target privately (never exported: catkin_lint).
 target_include_directories(variational_formation_ros SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
-target_link_libraries(variational_formation_ros variational_formation_core ${catkin_LIBRARIES})
+target_link_libraries(variational_formation_ros vf_core ${catkin_LIBRARIES})
 target_compile_options(variational_formation_ros PRIVATE ${VF_FLAGS})
-add_dependencies(variational_formation_ros ${PROJECT_NAME}_generate_messages_cpp ${catkin_EXPORTED_TARGETS})
+add_dependencies(variational_formation_ros ${catkin_EXPORTED_TARGETS})
 
 foreach(node agent monitor recorder agent_manager)
   add_executable(${node} src/ros/${node}_main.cpp)
@@ -144,13 +144,13 @@ add_executable(robot_sim src/ros/robot_sim_contacts.cpp src/ros/robot_sim_main.c
 target_include_directories(robot_sim SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(robot_sim variational_formation_ros variational_formation_contacts ${catkin_LIBRARIES})
 target_compile_options(robot_sim PRIVATE ${VF_FLAGS})
-add_dependencies(robot_sim ${PROJECT_NAME}_generate_messages_cpp ${catkin_EXPORTED_TARGETS})
+add_dependencies(robot_sim ${catkin_EXPORTED_TARGETS})
 install(TARGETS robot_sim RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 # The transport's ceiling for a nodelet run (benchmark/transport_ceiling.sh), built for the
 # checkout only, like benchmark_roa.
 add_executable(benchmark_transport benchmark/benchmark_transport.cpp)
-add_dependencies(benchmark_transport ${PROJECT_NAME}_generate_messages_cpp)
+add_dependencies(benchmark_transport ${catkin_EXPORTED_TARGETS})
 target_include_directories(benchmark_transport SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(benchmark_transport ${catkin_LIBRARIES})
 target_compile_options(benchmark_transport PRIVATE ${VF_FLAGS})

@@ -15,7 +15,7 @@ endif()
 
 # Contacts as both worlds count them (ContactLog; BodyContacts for robot_sim), without MuJoCo.
 add_library(variational_formation_contacts src/world/body_contacts.cpp src/world/contact_log.cpp)
-target_link_libraries(variational_formation_contacts PUBLIC variational_formation_core)
+target_link_libraries(variational_formation_contacts PUBLIC vf_core)
 target_compile_options(variational_formation_contacts PRIVATE ${VF_FLAGS})
 set_target_properties(variational_formation_contacts PROPERTIES POSITION_INDEPENDENT_CODE ON)
 install(TARGETS variational_formation_contacts
@@ -42,7 +42,7 @@ add_executable(mujoco_world src/ros/mujoco_world_main.cpp src/ros/mujoco_world_n
 target_include_directories(mujoco_world SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(mujoco_world variational_formation_ros variational_formation_world ${catkin_LIBRARIES})
 target_compile_options(mujoco_world PRIVATE ${VF_FLAGS})
-add_dependencies(mujoco_world ${PROJECT_NAME}_generate_messages_cpp ${catkin_EXPORTED_TARGETS})
+add_dependencies(mujoco_world ${catkin_EXPORTED_TARGETS})
 install(TARGETS mujoco_world RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 if(CATKIN_ENABLE_TESTING)

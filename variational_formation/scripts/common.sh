@@ -1,9 +1,11 @@
 # Shared by demo.sh, test.sh and the benchmarks: installs the Debian packages the package
 # needs, lays out a catkin workspace inside the repository (.ws, git-ignored) and builds it.
-# Source it; it defines REPO, WS and the functions below.
+# Source it; it defines REPO (this package's folder), ROOT (the repository, which holds the three
+# packages), WS and the functions below.
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-WS="${VF_WS:-$REPO/.ws}"
+ROOT="$(dirname "$REPO")"
+WS="${VF_WS:-$ROOT/.ws}"
 # Debian's ROS lives in /usr; a pyenv python3 earlier on PATH has no ROS modules.
 export PATH="/usr/bin:/bin:/usr/sbin:/sbin:$PATH"
 export ROS_HOME="${ROS_HOME:-$HOME/.ros}"
@@ -13,13 +15,22 @@ export ROS_HOSTNAME="${ROS_HOSTNAME:-localhost}"
 export MPLCONFIGDIR="$WS/matplotlib"
 export PYTHONDONTWRITEBYTECODE=1
 
-# The Debian packages: every dependency key of package.xml, through the one mapping in
-# scripts/debian_packages.txt (no rosdep database is needed). Plain bash and sed: on a fresh
-# machine nothing else may be installed yet.
+# The repository's packages: the folders of ROOT that hold a package.xml.
+vf_packages() {
+  local xml
+  for xml in "$ROOT"/*/package.xml; do basename "$(dirname "$xml")"; done
+}
+
+# The Debian packages: every dependency key of the packages' package.xml files, through the one
+# mapping in scripts/debian_packages.txt (no rosdep database is needed); a key that names one of
+# the repository's own packages is built, not installed. Plain bash and sed: on a fresh machine
+# nothing else may be installed yet.
 vf_apt_packages() {
-  local key line found
+  local key line found ours
+  ours=" $(vf_packages | tr '\n' ' ') "
   for key in $(sed -nE 's#^ *<(buildtool_|build_|build_export_|exec_|test_)?depend>([^<]+)</.*#\2#p' \
-                 "$REPO/package.xml" | sort -u); do
+                 "$ROOT"/*/package.xml | sort -u); do
+    case "$ours" in *" $key "*) continue ;; esac
     found=""
     while read -r line; do
       case "$line" in "$key: "*) found="${line#"$key: "}" ;; esac
@@ -49,22 +60,24 @@ vf_install_dependencies() {
 }
 
 vf_build() {
-  # The package in the workspace is a folder of links to the repository's entries, not one
-  # link to the repository: the workspace lives inside it, and rosrun's `find -L` would loop.
-  local pkg="$WS/src/variational_formation" entry
-  [ -L "$pkg" ] && rm "$pkg"
-  mkdir -p "$pkg"
-  find "$pkg" -maxdepth 1 -type l -delete
-  for entry in "$REPO"/*; do
-    case "$(basename "$entry")" in output|build|devel) continue ;; esac
-    ln -sfn "$entry" "$pkg/$(basename "$entry")"
+  # The workspace's src/ holds one link per package of the repository. The workspace lies
+  # beside the packages, in none of them, so rosrun's `find -L` never meets it. (A workspace of
+  # the one-package layout held a folder of links instead: it is replaced.)
+  local name
+  mkdir -p "$WS/src"
+  for name in $(vf_packages); do
+    if [ -d "$WS/src/$name" ] && [ ! -L "$WS/src/$name" ]; then
+      find "$WS/src/$name" -maxdepth 1 -type l -delete
+      rmdir "$WS/src/$name"
+    fi
+    ln -sfn "$ROOT/$name" "$WS/src/$name"
   done
   local jobs launcher=()
   jobs="$(nproc 2>/dev/null || echo 2)"
   # Where ccache is installed (a developer's machine, not CI's), builds of several checkouts
   # share one cache: paths below the checkouts' parent are hashed relative.
   if command -v ccache >/dev/null 2>&1; then
-    export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$(dirname "$REPO")}"
+    export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$(dirname "$ROOT")}"
     launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
   fi
   (cd "$WS" && catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 \

@@ -9,7 +9,7 @@ scenario="${1:-tetrahedron}"
 vf_install_dependencies
 vf_build
 vf_source
-out="$REPO/output"
+out="$ROOT/output"
 mkdir -p "$out"
 cfg="$REPO/config/$scenario.yaml"
 [ -f "$cfg" ] || cfg="$(cd "$(dirname "$scenario")" && pwd)/$(basename "$scenario")"

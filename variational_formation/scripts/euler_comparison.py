@@ -39,7 +39,7 @@ def find_simulate(given):
         if not (os.path.isfile(given) and os.access(given, os.X_OK)):
             fail(f"--simulate: '{given}' is not an executable file")
         return given
-    workspace = os.environ.get("VF_WS") or os.path.join(REPO, ".ws")
+    workspace = os.environ.get("VF_WS") or os.path.join(os.path.dirname(REPO), ".ws")
     for candidate in (os.path.join(workspace, "devel/lib/variational_formation/simulate"),
                       os.path.join(HERE, "simulate"), shutil.which("simulate")):
         if candidate and os.access(candidate, os.X_OK):

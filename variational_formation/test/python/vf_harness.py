@@ -12,7 +12,7 @@ import tempfile
 import unittest
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
-WS = os.environ.get("VF_WS") or os.path.join(REPO, ".ws")
+WS = os.environ.get("VF_WS") or os.path.join(os.path.dirname(REPO), ".ws")
 DEVEL_BIN = os.path.join(WS, "devel", "lib", "variational_formation")
 PYTHON = "/usr/bin/python3"
 sys.path.insert(0, os.path.join(REPO, "src"))
