@@ -6,6 +6,6 @@ target_sources(variational_formation_tools PRIVATE
 
 vf_add_tool(delay_margin src/tools/delay_margin_main.cpp)
 foreach(name delayed_integrator robot_mode robot_link)
-  vf_add_gtest(test_${name} test/core/test_${name}.cpp vf_core)
+  vf_add_gtest(test_${name} test/core/test_${name}.cpp "${variational_formation_core_LIBRARIES}")
 endforeach()
 vf_add_gtest(test_delay_margin test/tools/test_delay_margin.cpp variational_formation_tools)

@@ -1,11 +1,5 @@
 # The two shapes every tool and gtest of the package takes, declared once.
 
-# The core package as one target to link: its library and headers (Eigen's among them), as
-# catkin found them (find_package(catkin COMPONENTS variational_formation_core)).
-add_library(vf_core INTERFACE)
-target_link_libraries(vf_core INTERFACE ${variational_formation_core_LIBRARIES})
-target_include_directories(vf_core SYSTEM INTERFACE ${variational_formation_core_INCLUDE_DIRS})
-
 # A command-line tool: a thin main over variational_formation_tools, installed beside the
 # nodes so that `rosrun variational_formation <name>` finds it.
 function(vf_add_tool name main)

@@ -15,22 +15,18 @@ target_sources(variational_formation_ros PRIVATE src/ros/lockstep_monitor.cpp sr
   src/ros/recorder_bag.cpp src/ros/recorder_commands.cpp
   src/ros/sensing_hub.cpp src/ros/service_call.cpp src/ros/state_batch.cpp src/ros/periodic_call.cpp src/ros/pacer.cpp src/ros/trails.cpp)
 add_dependencies(variational_formation_ros ${PROJECT_NAME}_gencfg)
-# catkin's include path is given to each ROS target privately (never exported: catkin_lint).
-target_include_directories(variational_formation_ros SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
-target_link_libraries(variational_formation_ros vf_core ${catkin_LIBRARIES})
+target_link_libraries(variational_formation_ros ${variational_formation_core_LIBRARIES} ${catkin_LIBRARIES})
 target_compile_options(variational_formation_ros PRIVATE ${VF_FLAGS})
 add_dependencies(variational_formation_ros ${catkin_EXPORTED_TARGETS})
 
 foreach(node agent monitor recorder agent_manager)
   add_executable(${node} src/ros/${node}_main.cpp)
-  target_include_directories(${node} SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
   target_link_libraries(${node} variational_formation_ros)
   target_compile_options(${node} PRIVATE ${VF_FLAGS})
   install(TARGETS ${node} RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 endforeach()
 # The agent as a nodelet plugin (nodelet_plugins.xml), over the same AgentNode.
 add_library(variational_formation_nodelets src/ros/agent_nodelet.cpp)
-target_include_directories(variational_formation_nodelets SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(variational_formation_nodelets variational_formation_ros)
 target_compile_options(variational_formation_nodelets PRIVATE ${VF_FLAGS})
 install(TARGETS variational_formation_nodelets variational_formation_ros
@@ -83,12 +79,10 @@ if(CATKIN_ENABLE_TESTING)
   add_rostest(test/ros/goal.test)
   # The monitor's markers and trails (no master).
   catkin_add_gtest(test_markers test/ros/test_markers.cpp)
-  target_include_directories(test_markers SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
   target_link_libraries(test_markers variational_formation_ros gtest_main)
   target_compile_options(test_markers PRIVATE ${VF_FLAGS})
   # The bounded pool of service calls (no master).
   catkin_add_gtest(test_call_pool test/ros/test_call_pool.cpp)
-  target_include_directories(test_call_pool SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
   target_link_libraries(test_call_pool variational_formation_ros gtest_main)
   target_compile_options(test_call_pool PRIVATE ${VF_FLAGS})
   # Simulated robots (test/ros/robots_run.test): the hexagon with holonomic robots and with
@@ -141,7 +135,6 @@ endif()
 # robot_sim: one simulated holonomic robot (core PointRobot) per agent, with the interfaces of a
 # real one (cmd_vel in; nav_msgs/Odometry and tf out).
 add_executable(robot_sim src/ros/robot_sim_contacts.cpp src/ros/robot_sim_main.cpp src/ros/robot_sim_node.cpp)
-target_include_directories(robot_sim SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(robot_sim variational_formation_ros variational_formation_contacts ${catkin_LIBRARIES})
 target_compile_options(robot_sim PRIVATE ${VF_FLAGS})
 add_dependencies(robot_sim ${catkin_EXPORTED_TARGETS})
@@ -151,6 +144,5 @@ install(TARGETS robot_sim RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 # checkout only, like benchmark_roa.
 add_executable(benchmark_transport benchmark/benchmark_transport.cpp)
 add_dependencies(benchmark_transport ${catkin_EXPORTED_TARGETS})
-target_include_directories(benchmark_transport SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(benchmark_transport ${catkin_LIBRARIES})
 target_compile_options(benchmark_transport PRIVATE ${VF_FLAGS})

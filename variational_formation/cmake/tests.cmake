@@ -5,7 +5,7 @@ if(CATKIN_ENABLE_TESTING)
     rigidity slot_assignment shape_outcome safety_filter spatial_grid safety_scenario blocked_detector
     sparse_spectrum goal_steering timed_safety safety_watch sensing_board robot_shape_watch)
   foreach(name ${VF_CORE_TESTS} command_desk)
-    vf_add_gtest(test_${name} test/core/test_${name}.cpp vf_core)
+    vf_add_gtest(test_${name} test/core/test_${name}.cpp "${variational_formation_core_LIBRARIES}")
   endforeach()
   # The layer guard reads what the built core library links (test_layers.cpp).
   target_compile_definitions(test_layers PRIVATE VF_CORE_LIBRARY="$<TARGET_FILE:variational_formation_core>")

@@ -6,7 +6,7 @@ add_library(variational_formation_tools
   src/tools/scenario_info_cli.cpp
   src/tools/simulate_cli.cpp
 )
-target_link_libraries(variational_formation_tools PUBLIC vf_core)
+target_link_libraries(variational_formation_tools PUBLIC ${variational_formation_core_LIBRARIES})
 # Scenario names (--scenario hexagon) are looked up without ROS too, beside the running program
 # (tools/scenario_path.hpp): nothing about the build's folders is compiled in.
 target_sources(variational_formation_tools PRIVATE src/tools/scenario_path.cpp)

@@ -15,7 +15,7 @@ endif()
 
 # Contacts as both worlds count them (ContactLog; BodyContacts for robot_sim), without MuJoCo.
 add_library(variational_formation_contacts src/world/body_contacts.cpp src/world/contact_log.cpp)
-target_link_libraries(variational_formation_contacts PUBLIC vf_core)
+target_link_libraries(variational_formation_contacts PUBLIC ${variational_formation_core_LIBRARIES})
 target_compile_options(variational_formation_contacts PRIVATE ${VF_FLAGS})
 set_target_properties(variational_formation_contacts PROPERTIES POSITION_INDEPENDENT_CODE ON)
 install(TARGETS variational_formation_contacts
@@ -39,7 +39,6 @@ target_compile_options(world_step_response PRIVATE ${VF_FLAGS})
 install(TARGETS world_step_response RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 add_executable(mujoco_world src/ros/mujoco_world_main.cpp src/ros/mujoco_world_node.cpp src/ros/world_markers.cpp)
-target_include_directories(mujoco_world SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
 target_link_libraries(mujoco_world variational_formation_ros variational_formation_world ${catkin_LIBRARIES})
 target_compile_options(mujoco_world PRIVATE ${VF_FLAGS})
 add_dependencies(mujoco_world ${catkin_EXPORTED_TARGETS})
@@ -56,7 +55,6 @@ if(CATKIN_ENABLE_TESTING)
   endforeach()
   # The world's rviz markers, a function of the world (no master).
   catkin_add_gtest(test_world_markers test/world/test_world_markers.cpp src/ros/world_markers.cpp)
-  target_include_directories(test_world_markers SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
   target_link_libraries(test_world_markers variational_formation_ros variational_formation_world gtest_main)
   target_compile_options(test_world_markers PRIVATE ${VF_FLAGS})
 endif()

@@ -1,8 +1,9 @@
-// Layer guard: the core (include/variational_formation/core, src/core) includes only the
+// Layer guard: the core package (variational_formation_core: include/, src/) includes only the
 // standard library, Eigen, yaml-cpp and other core headers. A compile-time guard is not
 // possible on Debian, where ROS headers share /usr/include with Eigen, so this test reads
 // every core file and checks each #include against that allowlist, and reads the built core
-// library's link dependencies. The last test is a layout rule: headers named after a class.
+// library's link dependencies (what the core's package.xml and CMake declare is checked by
+// test/package/test_dependencies.py). The last test is a layout rule: headers named after a class.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -26,7 +27,7 @@ bool allowedInCore(const std::string& target) {
   static const std::regex standardLibrary("[a-z_0-9]+");  // <vector>, <cmath>: no '/' or '.'
   static const std::regex eigen("(Eigen|unsupported/Eigen)/[A-Za-z0-9_]+");
   static const std::regex yamlCpp("yaml-cpp/[A-Za-z0-9_/]+\\.h");
-  static const std::regex core("variational_formation/core/([a-z_0-9]+/)?[a-z_0-9]+\\.hpp");  // and core/protocol/
+  static const std::regex core("variational_formation_core/[a-z_0-9]+/[a-z_0-9]+\\.hpp");  // <concept>/<file>
   return std::regex_match(target, standardLibrary) || std::regex_match(target, eigen) ||
          std::regex_match(target, yamlCpp) || std::regex_match(target, core);
 }
@@ -65,7 +66,7 @@ TEST(LayerGuard, TheAllowlistRejectsRosAndOtherLayers) {
                           "tf2_msgs/TFMessage.h", "geometry_msgs/Point.h", "std_msgs/Header.h",
                           "visualization_msgs/MarkerArray.h", "rosbag/bag.h", "nodelet/nodelet.h",
                           "pluginlib/class_list_macros.h", "ros.h", "variational_formation_msgs/AgentState.h",
-                          "variational_formation/ros/markers.hpp",
+                          "variational_formation/ros/markers.hpp", "variational_formation/core/formation.hpp",
                           "variational_formation/tools/arguments.hpp", "boost/shared_ptr.hpp", "MACRO"}) {
     EXPECT_FALSE(allowedInCore(ros)) << ros;
   }
@@ -75,11 +76,13 @@ TEST(LayerGuard, TheAllowlistRejectsRosAndOtherLayers) {
   }
 }
 
+/// The core package's folder, beside this package's in the repository.
+fs::path coreRoot() { return fs::path(VF_SOURCE_DIR) / ".." / "variational_formation_core"; }
+
 TEST(LayerGuard, CoreIncludesNothingFromRos) {
-  const fs::path root(VF_SOURCE_DIR);
   int files = 0;
-  std::vector<Include> includes = includesUnder(root / "include/variational_formation/core", files);
-  const std::vector<Include> sources = includesUnder(root / "src/core", files);
+  std::vector<Include> includes = includesUnder(coreRoot() / "include", files);
+  const std::vector<Include> sources = includesUnder(coreRoot() / "src", files);
   includes.insert(includes.end(), sources.begin(), sources.end());
   // A wrong path would make this test pass vacuously.
   EXPECT_GE(files, 20);
@@ -88,7 +91,7 @@ TEST(LayerGuard, CoreIncludesNothingFromRos) {
     EXPECT_TRUE(allowedInCore(inc.target))
         << inc.file << ":" << inc.line << ": core includes '" << inc.target
         << "'; the core may include only the standard library, Eigen, yaml-cpp and "
-           "variational_formation/core headers";
+           "variational_formation_core headers";
   }
 }
 
@@ -163,52 +166,40 @@ std::string camelCase(const std::string& stem) {
   return out;
 }
 
-// A header that declares classes or structs is named after one of them (run_referee.hpp would
-// hold RunReferee). The files below predate the rule (issue 35, item 4 renames them); a new
-// mismatch fails, and so does an entry here once its file is renamed.
+// A header that declares classes or structs is named after one of them (lockstep_referee.hpp
+// holds LockstepReferee), in both packages' include folders. The files below hold a family of
+// types or functions with no one main class (the explicit integrators, the recovery answers, the
+// rigidity tests); a new mismatch fails, and so does an entry here once its file is renamed.
 TEST(LayerGuard, HeadersAreNamedAfterAClassTheyDeclare) {
   const std::map<std::string, std::string> exceptions = {
-      {"core/delayed_integrator.hpp", "DelayedVariationalIntegrator"},
-      {"core/error.hpp", "InvalidInput"},
-      {"core/explicit_integrators.hpp", "ExplicitEulerIntegrator, RungeKutta4Integrator"},
-      {"core/hand_point.hpp", "UnicycleCommand"},
-      {"core/manoeuvre.hpp", "ManoeuvreModel, ManoeuvreGains"},
-      {"core/manoeuvre_command.hpp", "Command, CommandSchedule"},
-      {"core/monitor.hpp", "FormationMonitor"},
-      {"core/procrustes.hpp", "RigidFit"},
-      {"core/protocol/recovery.hpp", "RecorderBuffers, MonitorResume"},
-      {"core/protocol/run_referee.hpp", "LockstepReferee"},
-      {"core/random.hpp", "StandardNormal"},
-      {"core/rigidity.hpp", "RigidityReport"},
-      {"core/roa.hpp", "RoaCampaign"},
-      {"core/robot_mode.hpp", "RobotLoopSettings"},
-      {"core/run_outcome.hpp", "RunVerdict"},
-      {"core/safety.hpp", "SafetySettings, Obstacle"},
-      {"core/safety_filter.hpp", "SafeStep"},
-      {"core/simulation.hpp", "StepMetrics"},
-      {"core/stability.hpp", "StepSizeAdvice"},
-      {"core/tracking.hpp", "CommandedFrame"},
-      {"core/validation.hpp", "FieldNames, ScenarioOverrides"},
-      {"core/variational_update.hpp", "VariationalCoefficients"},
-      {"ros/participants.hpp", "Recalled"},
-      {"ros/service_call.hpp", "CallPool"},
-      {"tools/formation_generators.hpp", "FormationGraph"},
-      {"world/mjcf_model.hpp", "StaticObstacle"},
+      {"variational_formation_core/integrators/explicit_integrators.hpp", "ExplicitEulerIntegrator, RungeKutta4Integrator"},
+      {"variational_formation_core/protocol/recovery.hpp", "RecorderBuffers, MonitorResume"},
+      {"variational_formation_core/model/rigidity.hpp", "RigidityReport"},
+      {"variational_formation_core/robots/robot_mode.hpp", "RobotLoopSettings"},
+      {"variational_formation_core/safety/safety_filter.hpp", "SafeStep"},
+      {"variational_formation_core/model/validation.hpp", "FieldNames, ScenarioOverrides"},
+      {"variational_formation_core/integrators/variational_update.hpp", "VariationalCoefficients"},
+      {"variational_formation_core/generators/formation_generators.hpp", "FormationGraph"},
+      {"variational_formation/ros/participants.hpp", "Recalled"},
+      {"variational_formation/ros/service_call.hpp", "CallPool"},
+      {"variational_formation/world/mjcf_model.hpp", "StaticObstacle"},
   };
-  const fs::path root = fs::path(VF_SOURCE_DIR) / "include/variational_formation";
+
   std::set<std::string> mismatched;
   int headers = 0;
-  for (const auto& entry : fs::recursive_directory_iterator(root)) {
-    if (entry.path().extension() != ".hpp") continue;
-    ++headers;
-    const std::vector<std::string> types = declaredTypes(entry.path());
-    const std::string expected = camelCase(entry.path().stem().string());
-    if (types.empty() || std::find(types.begin(), types.end(), expected) != types.end()) continue;
-    const std::string relative = fs::relative(entry.path(), root).generic_string();
-    mismatched.insert(relative);
-    EXPECT_TRUE(exceptions.count(relative))
-        << relative << " declares " << types.front() << " (and " << types.size() - 1
-        << " more) but no " << expected << ": name the file after its main class";
+  for (const fs::path& root : {fs::path(VF_SOURCE_DIR) / "include", coreRoot() / "include"}) {
+    for (const auto& entry : fs::recursive_directory_iterator(root)) {
+      if (entry.path().extension() != ".hpp") continue;
+      ++headers;
+      const std::vector<std::string> types = declaredTypes(entry.path());
+      const std::string expected = camelCase(entry.path().stem().string());
+      if (types.empty() || std::find(types.begin(), types.end(), expected) != types.end()) continue;
+      const std::string relative = fs::relative(entry.path(), root).generic_string();
+      mismatched.insert(relative);
+      EXPECT_TRUE(exceptions.count(relative))
+          << relative << " declares " << types.front() << " (and " << types.size() - 1
+          << " more) but no " << expected << ": name the file after its main class";
+    }
   }
   EXPECT_GE(headers, 60);  // the right folder
   for (const auto& [file, holds] : exceptions) {

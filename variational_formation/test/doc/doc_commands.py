@@ -10,6 +10,8 @@ import subprocess
 import xml.etree.ElementTree as ElementTree
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+# The repository, which holds README.md, doc/ and the three packages (ROOT is variational_formation's).
+REPOSITORY = os.path.dirname(ROOT)
 PKG = "variational_formation"
 SHELL_BLOCKS = {"", "bash", "sh", "shell", "console"}
 
@@ -20,7 +22,7 @@ def read(path):
 
 
 def pages():
-    return [os.path.join(ROOT, "README.md")] + sorted(glob.glob(os.path.join(ROOT, "doc", "*.md")))
+    return [os.path.join(REPOSITORY, "README.md")] + sorted(glob.glob(os.path.join(REPOSITORY, "doc", "*.md")))
 
 
 def snippets(text):
@@ -72,7 +74,7 @@ def every_command():
     for page in pages():
         for line, shell in snippets(read(page)):
             for words in commands(shell):
-                yield f"{os.path.relpath(page, ROOT)}:{line}", words
+                yield f"{os.path.relpath(page, REPOSITORY)}:{line}", words
 
 
 # --- what the package has ----------------------------------------------------------------------
@@ -111,8 +113,9 @@ def launch_args(path):
 # --- what scripts/test.sh installs ---------------------------------------------------------------
 
 def declared_keys():
-    return {e.text.strip() for e in ElementTree.parse(os.path.join(ROOT, "package.xml")).getroot()
-            if e.tag.endswith("depend")}
+    """The dependency keys of the repository's three packages."""
+    return {e.text.strip() for xml in glob.glob(os.path.join(REPOSITORY, "*", "package.xml"))
+            for e in ElementTree.parse(xml).getroot() if e.tag.endswith("depend")}
 
 
 def mapped_debian_packages(keys):

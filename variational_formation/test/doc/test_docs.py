@@ -34,7 +34,9 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import doc_commands  # noqa: E402
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
-API = os.path.join(ROOT, "doc", "ros_api.md")
+# The repository, which holds README.md, doc/ and the three packages (ROOT is variational_formation's).
+REPOSITORY = os.path.dirname(ROOT)
+API = os.path.join(REPOSITORY, "doc", "ros_api.md")
 README_MAX_LINES = 200
 
 # roscpp's reading calls, and the index of the name among their arguments.
@@ -64,7 +66,7 @@ def read(path):
 
 
 def relative(path):
-    return os.path.relpath(path, ROOT)
+    return os.path.relpath(path, REPOSITORY)
 
 
 # --- C++ -------------------------------------------------------------------------------------
@@ -487,8 +489,8 @@ class Docs(unittest.TestCase):
         self.assertEqual(wrong, [], "\n".join(wrong))
 
     def test_one_parameter_list(self):
-        pages = [os.path.join(ROOT, "README.md")] + [
-            os.path.join(ROOT, "doc", n) for n in sorted(os.listdir(os.path.join(ROOT, "doc"))) if n.endswith(".md")]
+        pages = [os.path.join(REPOSITORY, "README.md")] + [
+            os.path.join(REPOSITORY, "doc", n) for n in sorted(os.listdir(os.path.join(REPOSITORY, "doc"))) if n.endswith(".md")]
         tables = []
         for path in pages:
             if path == API:
@@ -501,8 +503,8 @@ class Docs(unittest.TestCase):
     def test_links_resolve(self):
         # Every relative link in README.md and doc/*.md names a file that exists and, with
         # #anchor, a heading of that page (GitHub's slugs): sections moved, links followed.
-        pages = [os.path.join(ROOT, "README.md")] + [
-            os.path.join(ROOT, "doc", n) for n in sorted(os.listdir(os.path.join(ROOT, "doc"))) if n.endswith(".md")]
+        pages = [os.path.join(REPOSITORY, "README.md")] + [
+            os.path.join(REPOSITORY, "doc", n) for n in sorted(os.listdir(os.path.join(REPOSITORY, "doc"))) if n.endswith(".md")]
         broken = []
         for page in pages:
             text = read(page)
@@ -601,10 +603,11 @@ class Docs(unittest.TestCase):
     def test_no_reference_outside_the_repository(self):
         # Every page named anywhere in the repository is one of its own, and no path climbs out
         # of it (the design notes and style guide of the workplace are not shipped).
-        # The workspace holds the package as a folder of links to the repository's entries: follow them.
-        pages = {n for _, _, names in os.walk(ROOT, followlinks=True) for n in names if n.endswith(".md")}
-        outside = []
-        for folder, dirs, names in os.walk(ROOT, followlinks=True):
+        pages, outside = set(), []
+        for _, dirs, names in os.walk(REPOSITORY):
+            dirs[:] = [d for d in dirs if not d.startswith(".") and d not in ("output", "build", "devel")]
+            pages |= {n for n in names if n.endswith(".md")}
+        for folder, dirs, names in os.walk(REPOSITORY):
             dirs[:] = [d for d in dirs if not d.startswith(".") and d not in ("output", "build", "devel")]
             for name in names:
                 path = os.path.join(folder, name)
@@ -620,7 +623,7 @@ class Docs(unittest.TestCase):
         self.assertEqual(outside, [], "references to files outside the repository:\n" + "\n".join(outside))
 
     def test_readme_is_a_front_door(self):
-        with open(os.path.join(ROOT, "README.md"), encoding="utf-8") as f:
+        with open(os.path.join(REPOSITORY, "README.md"), encoding="utf-8") as f:
             lines = f.read().splitlines()
         self.assertLessEqual(len(lines), README_MAX_LINES,
                              f"README.md has {len(lines)} lines; move details to doc/ (at most {README_MAX_LINES})")

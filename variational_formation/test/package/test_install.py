@@ -15,6 +15,8 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from vf_harness import REPO, WS, run  # noqa: E402
 
 PKG = "variational_formation"
+# The repository, which holds the three packages (and .ws): what the install must not name.
+TREE = os.path.dirname(REPO)
 
 
 def prefix_of_build():
@@ -55,11 +57,11 @@ class InstallTest(unittest.TestCase):
                "MPLCONFIGDIR": os.path.join(self.root, "mpl"), "LANG": "C.UTF-8"}
         argv = ["bash", "-c", script]
         if hide_source:
-            # A private mount namespace with an empty folder over the repository (and so over
-            # .ws: its source, build and devel spaces).
+            # A private mount namespace with an empty folder over the repository (its three
+            # packages, and .ws: the source, build and devel spaces).
             empty = os.path.join(self.root, "empty")
             os.makedirs(empty, exist_ok=True)
-            argv = ["unshare", "--mount", "bash", "-c", f"mount --bind {empty} {REPO} && {script}"]
+            argv = ["unshare", "--mount", "bash", "-c", f"mount --bind {empty} {TREE} && {script}"]
         return subprocess.run(argv, env=env, capture_output=True, text=True, timeout=timeout)
 
     def test_only_real_files_that_do_not_point_into_the_tree(self):
@@ -79,7 +81,7 @@ class InstallTest(unittest.TestCase):
                     # what was installed; the run below hides the devel space as well.
                     text = text.replace(prefix_of_build().encode(), b"").replace(
                         os.path.join(WS, "devel").encode(), b"")
-                    if REPO.encode() + b"/" in text:
+                    if TREE.encode() + b"/" in text:
                         mentions.append(os.path.relpath(path, self.prefix))
         self.assertEqual(links, [], "symbolic links in the install space")
         self.assertEqual(mentions, [], "installed files naming the source tree or workspace")
