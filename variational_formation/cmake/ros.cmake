@@ -2,7 +2,12 @@
 add_library(variational_formation_ros src/ros/agent_commands.cpp src/ros/agent_node.cpp src/ros/agent_recovery.cpp src/ros/markers.cpp
   src/ros/monitor_node.cpp
   src/ros/output_files.cpp
-  src/ros/participants.cpp
+  src/ros/participant_names.cpp
+  src/ros/frames.cpp
+  src/ros/shared_scenario.cpp
+  src/ros/formation_subscriptions.cpp
+  src/ros/recalled.cpp
+  src/ros/liveness.cpp
   src/ros/progress_message.cpp
   src/ros/recorder_node.cpp)
 # The time-driven agent (doc/robots.md), selected by the agent's ~mode.

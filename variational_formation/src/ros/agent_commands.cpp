@@ -1,7 +1,8 @@
 // The lockstep agent's side of live commands (AgentNode, agent_node.hpp; doc/protocol.md
 // "Commands"): the monitor's latched list of issued commands, applied in order by AgentProtocol.
 #include "variational_formation/ros/agent_node.hpp"
-#include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/formation_subscriptions.hpp"
+#include "variational_formation/ros/participant_names.hpp"
 
 namespace vf {
 

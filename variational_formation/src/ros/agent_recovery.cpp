@@ -3,7 +3,7 @@
 // answers `~recall` (the newest state it holds of an agent) and `~history` (its own recent states
 // or a neighbour's) for others that restart.
 #include "variational_formation/ros/agent_node.hpp"
-#include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/recalled.hpp"
 
 namespace vf {
 

@@ -2,7 +2,8 @@
 
 #include "variational_formation_core/protocol/recovery.hpp"
 #include "variational_formation/ros/monitor_node.hpp"
-#include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/liveness.hpp"
+#include "variational_formation/ros/participant_names.hpp"
 #include "variational_formation/ros/progress_message.hpp"
 
 namespace vf {

@@ -7,7 +7,7 @@
 #include "variational_formation_core/common/invalid_input.hpp"
 #include "variational_formation/ros/monitor_node.hpp"
 #include "variational_formation/ros/parameters.hpp"
-#include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/participant_names.hpp"
 
 namespace vf {
 

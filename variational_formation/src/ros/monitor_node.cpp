@@ -9,7 +9,10 @@
 #include "variational_formation_core/model/scenario.hpp"
 #include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/parameters.hpp"
-#include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/frames.hpp"
+#include "variational_formation/ros/liveness.hpp"
+#include "variational_formation/ros/output_files.hpp"
+#include "variational_formation/ros/participant_names.hpp"
 
 namespace vf {
 

@@ -10,7 +10,7 @@
 #include "variational_formation_core/robots/robot_link.hpp"
 #include "variational_formation/ros/monitor_node.hpp"
 #include "variational_formation/ros/parameters.hpp"
-#include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/liveness.hpp"
 
 namespace vf {
 

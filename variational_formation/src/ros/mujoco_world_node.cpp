@@ -13,7 +13,7 @@
 #include "variational_formation_core/model/scenario.hpp"
 #include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/parameters.hpp"
-#include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/frames.hpp"
 #include "variational_formation/ros/world_contact.hpp"
 #include "variational_formation/ros/world_markers.hpp"
 #include "variational_formation/world/mjcf_model.hpp"

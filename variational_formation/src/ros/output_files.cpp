@@ -1,6 +1,7 @@
 #include "variational_formation/ros/output_files.hpp"
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -58,6 +59,14 @@ void replaceEarlierBag(const std::string& path) {
   }
   ROS_WARN("recorder: replacing the bag of an earlier run %s%s", path.c_str(),
            removed > 0 ? (" (its " + std::to_string(removed) + " later parts removed)").c_str() : "");
+}
+
+void createParentDirectory(const std::string& path, const std::string& parameter) {
+  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  if (dir.empty()) return;
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error) throw InvalidInput(parameter + ": cannot create the directory '" + dir.string() + "': " + error.message());
 }
 
 }  // namespace vf

@@ -4,7 +4,7 @@
 
 #include <tf2_msgs/TFMessage.h>
 
-#include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/frames.hpp"
 #include "variational_formation/ros/recorder_node.hpp"
 
 namespace vf {

@@ -8,7 +8,9 @@
 #include "variational_formation_core/protocol/command_desk.hpp"
 #include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/parameters.hpp"
-#include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/formation_subscriptions.hpp"
+#include "variational_formation/ros/output_files.hpp"
+#include "variational_formation/ros/participant_names.hpp"
 #include "variational_formation/ros/recorder_node.hpp"
 
 namespace vf {

@@ -8,7 +8,9 @@
 #include "variational_formation_core/protocol/recovery.hpp"
 #include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/parameters.hpp"
-#include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/frames.hpp"
+#include "variational_formation/ros/output_files.hpp"
+#include "variational_formation/ros/participant_names.hpp"
 #include "variational_formation/ros/progress_message.hpp"
 #include "variational_formation/ros/service_call.hpp"
 

@@ -3,7 +3,6 @@
 #include "variational_formation_core/common/invalid_input.hpp"
 #include "variational_formation_core/common/number_checks.hpp"
 #include "variational_formation/ros/parameters.hpp"
-#include "variational_formation/ros/participants.hpp"
 #include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/robot_sim_node.hpp"
 #include "variational_formation/ros/world_contact.hpp"

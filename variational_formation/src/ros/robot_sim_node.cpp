@@ -7,7 +7,7 @@
 #include "variational_formation_core/common/invalid_input.hpp"
 #include "variational_formation_core/common/number_checks.hpp"
 #include "variational_formation/ros/parameters.hpp"
-#include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/frames.hpp"
 
 namespace vf {
 

@@ -4,7 +4,7 @@
 #include <mutex>
 
 #include "variational_formation_msgs/AgentState.h"
-#include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/participant_names.hpp"
 #include "variational_formation/ros/state_batch.hpp"
 
 namespace vf {

@@ -12,7 +12,11 @@
 #include "variational_formation_core/common/number_checks.hpp"
 #include "variational_formation_core/model/validation.hpp"
 #include "variational_formation/ros/parameters.hpp"
-#include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/formation_subscriptions.hpp"
+#include "variational_formation/ros/frames.hpp"
+#include "variational_formation/ros/liveness.hpp"
+#include "variational_formation/ros/participant_names.hpp"
+#include "variational_formation/ros/recalled.hpp"
 
 namespace vf {
 

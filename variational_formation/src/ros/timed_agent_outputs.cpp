@@ -4,7 +4,8 @@
 #include <geometry_msgs/Twist.h>
 
 #include "variational_formation_core/model/validation.hpp"
-#include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/frames.hpp"
+#include "variational_formation/ros/participant_names.hpp"
 #include "variational_formation/ros/timed_agent_node.hpp"
 
 namespace vf {

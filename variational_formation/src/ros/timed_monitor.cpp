@@ -3,7 +3,6 @@
 #include "variational_formation_core/common/number_checks.hpp"
 #include "variational_formation/ros/monitor_node.hpp"
 #include "variational_formation/ros/parameters.hpp"
-#include "variational_formation/ros/participants.hpp"
 
 namespace vf {
 

@@ -180,7 +180,6 @@ TEST(LayerGuard, HeadersAreNamedAfterAClassTheyDeclare) {
       {"variational_formation_core/model/validation.hpp", "FieldNames, ScenarioOverrides"},
       {"variational_formation_core/integrators/variational_update.hpp", "VariationalCoefficients"},
       {"variational_formation_core/generators/formation_generators.hpp", "FormationGraph"},
-      {"variational_formation/ros/participants.hpp", "Recalled"},
       {"variational_formation/ros/service_call.hpp", "CallPool"},
       {"variational_formation/world/mjcf_model.hpp", "StaticObstacle"},
   };

@@ -13,7 +13,7 @@
 #include "variational_formation_msgs/RecallState.h"
 #include "variational_formation_msgs/RunProgress.h"
 #include "variational_formation/ros/periodic_call.hpp"
-#include "variational_formation/ros/participants.hpp"
+#include "variational_formation/ros/recalled.hpp"
 #include "variational_formation_core/agents/lockstep_agent.hpp"
 #include "variational_formation_core/protocol/agent_protocol.hpp"
 

@@ -34,4 +34,8 @@ void replaceEarlierBag(const std::string& path);
  */
 bool appendToResult(const std::string& path, const std::string& lines);
 
+/// Creates the directory that will hold `path` (like mkdir -p). @throws InvalidInput naming
+/// `parameter` when it cannot.
+void createParentDirectory(const std::string& path, const std::string& parameter);
+
 }  // namespace vf
