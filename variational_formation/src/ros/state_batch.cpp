@@ -55,7 +55,7 @@ void StateBatch::flushEvery5ms() {
 void StateBatch::add(const variational_formation_msgs::AgentState::ConstPtr& state) {
   const int id = static_cast<int>(state->id);
   if (ids_.count(id) == 0) return;
-  variational_formation::AgentStatesPtr full;
+  variational_formation_msgs::AgentStatesPtr full;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     newest_[id] = state;
@@ -65,11 +65,11 @@ void StateBatch::add(const variational_formation_msgs::AgentState::ConstPtr& sta
     pending_ = boost::make_shared<variational_formation_msgs::AgentStates>();
     pending_->states.reserve(ids_.size());
   }
-  pub_.publish(variational_formation::AgentStatesConstPtr(full));
+  pub_.publish(variational_formation_msgs::AgentStatesConstPtr(full));
 }
 
 void StateBatch::flush() {
-  variational_formation::AgentStatesPtr held;
+  variational_formation_msgs::AgentStatesPtr held;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (pending_->states.empty()) return;
@@ -77,7 +77,7 @@ void StateBatch::flush() {
     pending_ = boost::make_shared<variational_formation_msgs::AgentStates>();
     pending_->states.reserve(ids_.size());
   }
-  pub_.publish(variational_formation::AgentStatesConstPtr(held));
+  pub_.publish(variational_formation_msgs::AgentStatesConstPtr(held));
 }
 
 void StateBatch::onConnect(const ros::SingleSubscriberPublisher& subscriber) {

@@ -20,7 +20,7 @@
 namespace vf {
 
 using variational_formation_msgs::AgentState;
-using variational_formation::AgentStatePtr;
+using variational_formation_msgs::AgentStatePtr;
 using variational_formation_msgs::RecallHistory;
 using variational_formation_msgs::RecallState;
 using variational_formation_msgs::RunProgress;

@@ -54,7 +54,7 @@ class StateBatch {
 
   std::set<int> ids_;
   std::mutex mutex_;
-  variational_formation::AgentStatesPtr pending_;
+  variational_formation_msgs::AgentStatesPtr pending_;
   std::map<int, variational_formation_msgs::AgentState::ConstPtr> newest_;
   ros::Publisher pub_;
   bool stopping_ = false;  // guarded by mutex_
