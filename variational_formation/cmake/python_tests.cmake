@@ -6,6 +6,7 @@ if(CATKIN_ENABLE_TESTING)
     "python_helpers:test/python/test_helpers.py"
     "python_scripts:test/python/test_scripts.py"
     "python_render_inputs:test/python/test_render_inputs.py"
+    "python_render_cut:test/python/test_render_cut.py"
     "package_dependencies:test/package/test_dependencies.py"
     "package_message_classes:test/package/test_message_classes.py"
     "package_catkin_lint:test/package/test_catkin_lint.py"

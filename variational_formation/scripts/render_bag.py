@@ -4,9 +4,9 @@ frames, the status text) to an MP4, a GIF or both, with no desktop.
 
 It starts a ROS master of its own on a free port (with /use_sim_time), Xvfb, and rviz full
 screen on it; replays the bag with `rosbag play --clock` at --speed, and captures the display
-with ffmpeg (x11grab). The video lasts (to - from) / speed seconds. A bag split by the recorder
-(<name>.bag, <name>_1.bag, ...) is read whole from its first part. Every process it starts is
-stopped when it ends, also on Ctrl-C or SIGTERM.
+with ffmpeg (x11grab). The video lasts (to - from) / speed seconds and one to two frames
+(video_frames). A bag split by the recorder (<name>.bag, <name>_1.bag, ...) is read whole from
+its first part. Every process it starts is stopped when it ends, also on Ctrl-C or SIGTERM.
 
 usage: render_bag.py BAG [BAG ...] [--out FILE.mp4 [FILE.gif]] [--speed S] [--size WxH]
                      [--fps N] [--from SEC] [--to SEC] [--ns NAMESPACE] [--camera fit|config]
@@ -14,6 +14,7 @@ usage: render_bag.py BAG [BAG ...] [--out FILE.mp4 [FILE.gif]] [--speed S] [--si
 Details: doc/render.md.
 """
 import argparse
+import math
 import os
 import re
 import select
@@ -546,17 +547,28 @@ def replay(procs, args, player, first, span, rviz, capture, progress):
     return started
 
 
-def encode(capture_path, offset, duration, outs, fps):
-    """The final videos: `duration` seconds of the capture from `offset` seconds into it."""
+def video_frames(seconds, speed, fps):
+    """How many frames show `seconds` of the run at `speed`: one every 1/fps [s] of video from the
+    first instant's picture, to the first at or after the last instant (so the last frame shows
+    it; a thousandth of a frame of rounding aside)."""
+    return math.ceil(seconds / speed * fps - 1e-3) + 1
+
+
+def encode(capture_path, offset, frames, outs, fps):
+    """The final videos: `frames` frames at `fps` from the capture's frame `offset` seconds into it
+    on (the first at 0 s: a capture frame a little after `offset` is not pushed to the next
+    frame's slot, which would leave the video's first slot empty and drop its last picture)."""
     for out in outs:
         if out.lower().endswith(".gif"):
-            codec = ["-filter_complex", "[0:v]split[a][b];[a]palettegen=stats_mode=diff[p];[b][p]paletteuse=dither=none",
-                     "-loop", "0"]
+            codec = ["-filter_complex", "[0:v]setpts=PTS-STARTPTS,split[a][b];[a]palettegen=stats_mode=diff[p];"
+                     "[b][p]paletteuse=dither=none", "-loop", "0"]
         else:
-            codec = ["-c:v", "libx264", "-preset", "veryfast", "-crf", "23", "-pix_fmt", "yuv420p", "-movflags",
-                     "+faststart"]
-        cmd = ["ffmpeg", "-nostdin", "-hide_banner", "-loglevel", "error", "-ss", f"{offset:.3f}", "-i", capture_path,
-               "-t", f"{duration:.3f}", "-r", str(fps)] + codec + ["-y", out]
+            codec = ["-vf", "setpts=PTS-STARTPTS", "-c:v", "libx264", "-preset", "veryfast", "-crf", "23", "-pix_fmt",
+                     "yuv420p", "-movflags", "+faststart"]
+        # The input ends a frame after the cut: the GIF's palette is of the cut's pictures.
+        cmd = ["ffmpeg", "-nostdin", "-hide_banner", "-loglevel", "error", "-ss", f"{offset:.3f}", "-t",
+               f"{(frames + 1) / fps:.3f}", "-i", capture_path, "-r", str(fps), "-frames:v", str(frames)] + codec + [
+               "-y", out]
         result = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True)
         if result.returncode != 0:
             lines = result.stderr.decode(errors="replace").strip().splitlines()
@@ -567,9 +579,11 @@ def first_drawn(path, capture_start, since, width, height):
     """Wall-clock time of the first captured frame from `since` on that differs from the picture
     before `since`; `since` itself if none does within LATENCY_MAX."""
     import numpy as np
+    # passthrough: one picture per captured frame, paired with showinfo's stamps (rawvideo's
+    # default constant rate repeats a picture where x11grab skipped frames and shifts the pairs).
     cmd = ["ffmpeg", "-nostdin", "-hide_banner", "-loglevel", "info", "-ss", f"{max(0.0, since - capture_start - 0.5):.3f}",
-           "-t", f"{LATENCY_MAX + 0.5:.3f}", "-i", path, "-copyts", "-vf", "showinfo", "-f", "rawvideo", "-pix_fmt",
-           "gray", "-"]
+           "-t", f"{LATENCY_MAX + 0.5:.3f}", "-i", path, "-copyts", "-vf", "showinfo", "-fps_mode", "passthrough",
+           "-f", "rawvideo", "-pix_fmt", "gray", "-"]
     result = subprocess.run(cmd, capture_output=True, start_new_session=True)
     # showinfo's pts_time is rounded; pts is exact, in the time base it states first.
     base = re.search(rb"time_base:\s*(\d+)/(\d+)", result.stderr)
@@ -609,6 +623,7 @@ def render(args, procs, tmp, progress):
     contents = BagContents(args.bags)
     prefix, markers, odometry, topics = choose_topics(contents, args.ns)
     run = RunSpan(contents, prefix + "/formation/status", markers, args.start, args.end)
+    frames = video_frames(run.end - run.start, args.speed, args.fps)
     if run.on_wall_time:
         # A timed or robots bag: replay a copy on the run's clock (variational_formation/run_clock.py).
         copy = os.path.join(tmp, "run.bag")
@@ -637,8 +652,7 @@ def render(args, procs, tmp, progress):
     count, second = first_instant(contents, topics, first)
     warm_up(procs, player, rviz, count)
     started = replay(procs, args, player, first, span, rviz, capture, progress)
-    # One frame more than the span: the last frame shows the span's last message.
-    played = span / args.speed + 1.0 / args.fps
+    played = frames / args.fps
     # The capture must hold the last picture, drawn up to LATENCY_MAX late.
     while time.time() < started + played + LATENCY_MAX + 0.2:
         time.sleep(0.05)
@@ -655,7 +669,7 @@ def render(args, procs, tmp, progress):
     latency = min(LATENCY_MAX, max(0.0, first_drawn(capture_path, start_time, started + shown, args.width, args.height)
                                    - started - shown))
     offset = started + latency - start_time - 0.5 / args.fps
-    encode(capture_path, max(0.0, offset), played, args.out, args.fps)
+    encode(capture_path, max(0.0, offset), frames, args.out, args.fps)
     timings["encoding"] = time.time()
     return run.start, run.end, played, timings
 

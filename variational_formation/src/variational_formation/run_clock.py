@@ -59,7 +59,8 @@ class RunSpan:
                     else:
                         continue
                     received[topic].setdefault(stamp, []).append(t.to_sec())
-        shown = [(time, stamp) for time, stamp in steps if time >= start and (end is None or time <= end)]
+        # In the run's order: a burst received late puts earlier steps after later ones in the bag.
+        shown = sorted((time, stamp) for time, stamp in steps if time >= start and (end is None or time <= end))
         # From and to a step with markers, where the bag has them: rosbag record may subscribe to
         # the status a step before it does to the markers.
         shown = [s for s in shown if s[1] in received[markers]] or shown
@@ -75,6 +76,10 @@ class RunSpan:
         self.times = np.array([clock[s] for s in self.stamps])
         self.on_wall_time = bool(np.any(np.abs(self.stamps - self.times) > 1e-3))
         if self.on_wall_time:
+            # Compared in nanoseconds: at today's epoch a stamp in seconds is rounded to 0.24 us,
+            # and stamp.to_sec() and nsec * 1e-9 round it differently (the first or last step's
+            # markers fell out of the copy).
+            self.first_ns, self.last_ns = first, last
             self.first_stamp, self.last_stamp = first * 1e-9, last * 1e-9
             first_time, last_time = self.start, self.end
         else:
@@ -103,12 +108,13 @@ class RunSpan:
                     static = topic == "/tf_static"
                     for _, msg, t in bag.read_messages(topics=[topic], **({} if static else window)):
                         headers = [h for h in stamped_headers(msg) if not h.stamp.is_zero()]
-                        stamp = max([h.stamp.to_sec() for h in headers] or [t.to_sec()])
-                        if not static and not self.first_stamp <= stamp <= self.last_stamp:
+                        stamp = max([h.stamp.to_nsec() for h in headers] or [t.to_nsec()])
+                        if not static and not self.first_ns <= stamp <= self.last_ns:
                             continue
                         for h in headers:
-                            h.stamp = rospy.Time.from_sec(self.run_time(h.stamp.to_sec()))
-                        copied.append((self.start if static else self.run_time(stamp), len(copied), topic, msg))
+                            h.stamp = rospy.Time.from_sec(self.run_time(h.stamp.to_nsec() * 1e-9))
+                        copied.append((self.start if static else self.run_time(stamp * 1e-9), len(copied), topic,
+                                       msg))
         copied.sort(key=lambda c: c[:2])
         with rosbag.Bag(path, "w") as out:
             for time, _, topic, msg in copied:

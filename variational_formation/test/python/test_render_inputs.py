@@ -6,7 +6,8 @@ timers under load), and a burst of 20 steps reaches the bag 0.5 s late.
 - The part it replays (variational_formation/run_clock.py) runs from the markers of the run's
   first shown step to those of its last, on the run's own clock: each message at the run's time
   of its stamp, so that the video's time is the run's time (the status's t_k = k h), whatever
-  the bag's time; --from/--to count the run's time.
+  the bag's time; --from/--to count the run's time. The copy holds the first and the last shown
+  steps' markers, whatever the rounding of their stamps in seconds and the order of reception.
 - The rviz configuration it writes draws one name per robot: the agents' frames are named, the
   robots' base_link frames (on top of them) keep their axes but no name.
 """
@@ -121,6 +122,22 @@ class RobotsBagTest(TempDirTestCase):
         # wall time, which is 50.5 Hz of the run's.
         self.assertEqual(len(robots), int(STEPS * H * STRETCH * 50) + 1)
         self.assertTrue(all(0.0 <= t <= STEPS * H and t == stamp for t, stamp in robots))
+
+    def test_the_copy_holds_the_first_and_last_shown_steps(self):
+        # At this epoch a stamp in seconds is rounded to 0.24 us, differently from its
+        # nanoseconds times 1e-9 for about half the steps: the copy compares the stamps exactly.
+        # From k = 10 on, --to falls after the burst (steps 40 to 59 received after step 60).
+        for k in range(40):
+            with self.subTest(first_step=k):
+                run = self.span(k * H, (k + 50) * H)
+                copy = self.path(f"run{k}.bag")
+                run.write_on_run_time(self.contents, ["/formation/markers"], copy)
+                with rosbag.Bag(copy) as bag:
+                    shown = [(int(msg.markers[0].text), t.to_sec()) for _, msg, t in bag.read_messages()]
+                self.assertEqual([step for step, _ in shown], list(range(k, k + 51)))
+                # The bag's times are whole nanoseconds (rospy rounds down).
+                self.assertAlmostEqual(shown[0][1], run.start, delta=2e-9)
+                self.assertAlmostEqual(shown[-1][1], run.end, delta=2e-9)
 
     def test_from_and_to_count_the_runs_time(self):
         run = self.span(1.0, 2.5)

@@ -13,8 +13,9 @@ another X server), rviz that dies.
 robots.launch's bag is on wall time and holds the robots' messages until after the run's last
 step (here 1 s after it, as a launch ending at the run's end would), and from before its first
 step or from the step at which rosbag record joined: its video is the run from the first
-recorded step (within two steps) to the last, (4.2 s - that step's t) over the speed within 1.5
-frames, not the bag's length; 90 % of the frames and the last one show every agent.
+recorded step (within two steps) to the last, not the bag's length: frames 1/fps apart from 0 s,
+the last at or after (4.2 s - that step's t) over the speed and the one before it before; 90 %
+of the frames and the last one show every agent.
 
 With `mujoco` (render.test kind:=mujoco), the bag of robots.launch world:=mujoco with unicycles:
 the same checks, and the bag holds the world's markers at 20 Hz from when rosbag record joined them,
@@ -339,11 +340,22 @@ class RenderRobotsTest(RecordedHexagon):
         self.assertTrue(shown, out)
         self.assertAlmostEqual(float(shown[1]), joined, delta=2 * STEP + 0.005, msg=out)
         self.assertEqual(shown[2], f"{RUN_SECONDS:.2f}", out)
-        probe = subprocess.run(["ffprobe", "-v", "error", "-show_entries", "format=duration", "-of",
-                                "default=noprint_wrappers=1:nokey=1", video], capture_output=True, text=True, check=True)
-        # The monitor's ticks: within one of the run's steps at each end, and a frame.
-        self.assertAlmostEqual(float(probe.stdout), (RUN_SECONDS - float(shown[1])) / SPEED, delta=1.5 / FPS,
-                               msg=f"the video's length; the bag lasts {length:.2f} s")
+        # The first shown step's t, printed to 10 ms (the steps are 14 ms apart), and the video
+        # from its picture to the last step's.
+        seconds = (RUN_SECONDS - round(float(shown[1]) / STEP) * STEP) / SPEED
+        probe = subprocess.run(["ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
+                                "stream=r_frame_rate,start_time,nb_read_frames:format=duration", "-of",
+                                "default=noprint_wrappers=1", video], capture_output=True, text=True, check=True)
+        info = dict(line.split("=", 1) for line in probe.stdout.split())
+        count, why = int(info["nb_read_frames"]), f"the video's frames for {seconds:.3f} s; {out}; {info}"
+        # At the frame rate from 0 s, no slot without a picture: its length is its frames'.
+        self.assertEqual(info["r_frame_rate"], f"{FPS}/1", why)
+        self.assertAlmostEqual(float(info["start_time"]), 0.0, delta=1e-3, msg=why)
+        self.assertAlmostEqual(float(info["duration"]), count / FPS, delta=1e-3, msg=why)
+        # Frames 1/FPS apart: the last at or after the run's last step (it shows it), the one
+        # before it before (no frame past the run's end).
+        self.assertGreaterEqual((count - 1) / FPS, seconds - 1e-4, why)
+        self.assertLess((count - 2) / FPS, seconds, f"{why}; the bag lasts {length:.2f} s")
         raw = subprocess.run(["ffmpeg", "-v", "error", "-i", video, "-f", "rawvideo", "-pix_fmt", "rgb24", "-"],
                              capture_output=True, check=True).stdout
         frames = np.frombuffer(raw, dtype=np.uint8).reshape(-1, HEIGHT, WIDTH, 3)
