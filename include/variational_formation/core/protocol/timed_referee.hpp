@@ -99,7 +99,7 @@ class TimedReferee {
     const long completed = completedStep(), last = monitor_->scenario().steps;
     if (last > 0 && completed >= last) return finishInto(r);
     const bool starts = progress_.state == Progress::State::Waiting;
-    if (starts ? (e.viewer || !waitForViewer_) : completed > progress_.completedStep + std::max<long>(1, window_ / 4)) {  // BROKEN
+    if (starts ? (e.viewer || !waitForViewer_) : completed >= progress_.completedStep + std::max<long>(1, window_ / 4)) {
       progress_.state = Progress::State::Running;
       progress_.completedStep = completed;
       progress_.allowedStep = last > 0 ? std::min(completed + window_, last) : completed + window_;
