@@ -56,45 +56,27 @@ void LockstepMonitor::onRecorderProgress(const ros::MessageEvent<RunProgress con
   const RunProgress& p = *event.getConstMessage();
   recorder_.seen = true;
   recorder_.goneSince = ros::WallTime();
-  if (p.state == RunProgress::FAILED) {
-    finish(RunProgress::FAILED, "the recorder failed: " + p.reason);
-    return;
-  }
-  referee_->recorderProgress(p.completed_step, p.state == RunProgress::FINISHED);
-  updateProgress();
+  carryOut(referee_->step(Referee::RecorderReport{p.completed_step, p.state == RunProgress::FINISHED,
+                                                  p.state == RunProgress::FAILED ? p.reason : "", viewer()}));
 }
 
-void LockstepMonitor::publishCompleted() {
-  for (const FormationSnapshot& s : referee_->takeCompleted()) {
+void LockstepMonitor::carryOut(const Referee::Ready& r) {
+  for (const FormationSnapshot& s : r.publish) {
     ros::Time stamp;
     stamp.fromSec(s.metrics.time);  // simulated time t_k
     // The Noether predictions are those of the unforced run: NaN under a commanded motion.
     referee_->keep(s.metrics.step, publishSnapshot(s, stamp, 0.0, commandSchedule() == nullptr));
   }
-  updateProgress();
-}
-
-void LockstepMonitor::updateProgress() {
-  if (ended()) return;
-  const bool waiting = !referee_->running();
-  const bool changed = referee_->updateProgress(!waitForViewer_ || markersPub_.getNumSubscribers() > 0);
-  if (changed && referee_->ended()) {
-    finish(RunProgress::FINISHED, "");  // the referee ends a run only by finishing it here
-    return;
-  }
-  RunProgress next = toMessage(referee_->progressNow());
-  // A pending command goes out at the allowed step, before the progress that counts it, and
-  // after every step whose status is out: a status counts every command stamped at or before its
-  // step, so the recorder knows which commands a step waits for (the allowed step equals the
-  // completed one while the agents wait for a lagging recorder).
+  if (ended()) return;  // a published step was blocked: that Ready ended the run
   const long issuedBefore = commandsIssued();
-  const long published = referee_->completedStep();
-  const long last = scenario_.steps;
-  const long at = (last <= 0 || published < last) ? std::max(next.allowed_step, published + 1) : next.allowed_step;
-  next.commands = issueCommands(at);
-  if (!changed && next.commands == issuedBefore) return;
-  if (waiting && referee_->running()) startedAt_ = ros::WallTime::now();
-  publishProgress(next);
+  if (r.commandsAt >= 0) issueCommands(r.commandsAt);
+  if (r.progress || commandsIssued() != issuedBefore) {
+    RunProgress next = toMessage(referee_->progressNow());
+    next.commands = commandsIssued();
+    if (r.starts) startedAt_ = ros::WallTime::now();
+    publishProgress(next);
+  }
+  if (r.finish) finish(referee_->progressNow());
 }
 
 void LockstepMonitor::watch() {
@@ -111,7 +93,7 @@ void LockstepMonitor::watch() {
       const auto held = fetchHistories(missing);
       for (std::size_t k = 0; k < missing.size(); ++k) referee_->offerHistory(missing[k], held[k].states);
       catchUpFromNeighbours(referee_->missing());
-      publishCompleted();
+      updateProgress();
     }
     if (recording_ && !checkAlive(recorder_, "the recorder", 0.0)) return;
     // A status published while the recorder's connection was coming up (after a restart of
@@ -212,9 +194,10 @@ void LockstepMonitor::begin() {
                        over, h.progress.state == RunProgress::FINISHED});
     histories.push_back(h.states);
   }
-  if (!referee_->resume(answers, histories)) {
-    // It did not witness a run that is over: neither its outcome nor a new run is its to report.
-    if (referee_->ended()) finish(RunProgress::FAILED, referee_->progressNow().reason);
+  const Referee::Ready resumed = referee_->step(Referee::Resume{answers, histories});
+  // It did not witness a run that is over: neither its outcome nor a new run is its to report.
+  carryOut(resumed);
+  if (!referee_->running()) {
     if (!ended()) resumeCommands(false);
     return;  // or a new run
   }
@@ -228,7 +211,7 @@ void LockstepMonitor::begin() {
   for (Participant& a : agents_) a.seen = true;
   ROS_INFO("monitor: resuming a run in progress at step %ld (rebuilt from the agents' histories)", r.step);
   lastCompletedAt_ = ros::WallTime::now();
-  publishCompleted();
+  updateProgress();
 }
 
 }  // namespace vf

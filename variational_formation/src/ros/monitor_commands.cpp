@@ -137,7 +137,7 @@ void MonitorNode::resumeCommands(bool resumed) {
       measureUnder(desk_->schedule());
       ROS_INFO("monitor: going on with the %zu commands issued before the restart", issued.entries().size());
     } catch (const InvalidInput& e) {
-      finish(RunProgress::FAILED, std::string("the kept commands cannot be read: ") + e.what());
+      report(protocol::Failure{std::string("the kept commands cannot be read: ") + e.what()});
       return;
     }
   }

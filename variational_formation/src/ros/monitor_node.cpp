@@ -129,7 +129,7 @@ void MonitorNode::onBatch(std::size_t source, const ros::MessageEvent<variationa
 
 bool MonitorNode::admit(int agent, const AgentState& msg, const std::string& publisher) {
   if (!msg.failure.empty()) {
-    finish(RunProgress::FAILED, agents_[static_cast<std::size_t>(agent)].node + ": " + msg.failure);
+    report(protocol::Failure{agents_[static_cast<std::size_t>(agent)].node + ": " + msg.failure});
     return false;
   }
   if (!offer(agent, msg, publisher)) return false;
@@ -173,7 +173,7 @@ bool MonitorNode::checkAlive(Participant& p, const std::string& what, double tim
     }
   }
   if (secondsSince(p.goneSince) < timeout) return true;
-  finish(RunProgress::FAILED, what + " " + p.node + " ended before the run was over (" + describe(l) + host + ")");
+  report(protocol::Failure{what + " " + p.node + " ended before the run was over (" + describe(l) + host + ")"});
   return false;
 }
 

@@ -8,6 +8,7 @@
 #include "variational_formation_core/agents/run_verdict.hpp"
 #include "variational_formation/ros/markers.hpp"
 #include "variational_formation/ros/monitor_node.hpp"
+#include "variational_formation/ros/progress_message.hpp"
 
 namespace vf {
 
@@ -68,7 +69,7 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
     ROS_INFO("monitor: left the desired shape at step %ld", s.metrics.step);
     reportedConvergence_ = -2;
   }
-  if (blocked) finish(RunProgress::FINISHED, "");  // the formation cannot form: say so instead of running on
+  if (blocked) report(protocol::Blocked{});  // the formation cannot form: say so instead of running on
   return out;
 }
 
@@ -87,8 +88,10 @@ void MonitorNode::writeResult(const std::string& result, const std::string& reas
   if (!f) ROS_ERROR("monitor: cannot write the result file %s", resultFile_.c_str());
 }
 
-void MonitorNode::finish(uint8_t state, std::string reason) {
+void MonitorNode::finish(const protocol::Progress& end) {
   if (ended()) return;
+  uint8_t state = toMessage(end).state;
+  std::string reason = end.reason;
   const long last = completedStep();
   goals_->end("the run ended at step " + std::to_string(last));
   const double h = scenario_.timeStep;

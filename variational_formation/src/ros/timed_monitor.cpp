@@ -3,6 +3,7 @@
 #include "variational_formation_core/common/number_checks.hpp"
 #include "variational_formation/ros/monitor_node.hpp"
 #include "variational_formation/ros/parameters.hpp"
+#include "variational_formation/ros/progress_message.hpp"
 
 namespace vf {
 
@@ -13,7 +14,7 @@ constexpr double kStaleAfter = 1.0;  // an agent silent this long is checked for
 TimedMonitor::TimedMonitor(ros::NodeHandle& nh, ros::NodeHandle& pnh) : MonitorNode(nh, pnh, true) {
   rate_ = optionalParam(pnh, "real_time_factor", 0.0);
   requireFiniteAbove("~real_time_factor (timed mode: the status period is h / rate)", rate_, 0.0, "");
-  referee_ = std::make_unique<protocol::TimedReferee<AgentState>>(scenario_, kStaleAfter);
+  referee_ = std::make_unique<protocol::TimedReferee<AgentState>>(scenario_, kStaleAfter, window_, waitForViewer_);
   announce("");
 }
 
@@ -27,51 +28,29 @@ bool TimedMonitor::offer(int agent, const AgentState& msg, const std::string& pu
   return true;
 }
 
-void TimedMonitor::commandOffered() {
-  // Stamped with the monitor's tick (after the last issued one); the agents take the newest.
-  long step = completedStep() + 1;
-  if (!desk_->issued().empty()) step = std::max(step, desk_->issued().back().first + 1);
-  issueCommands(step);
-}
+void TimedMonitor::commandOffered() { issueCommands(referee_->commandStep(lastCommandStep())); }
 
 void TimedMonitor::begin() {
   resumeCommands(false);  // agents keep the command they have; a new one replaces it
   tickTimer_ = nh_.createWallTimer(ros::WallDuration(scenario_.timeStep / rate_),
-                                   [this](const ros::WallTimerEvent&) { tick(); });
+                                   [this](const ros::WallTimerEvent&) {
+                                     carryOut(referee_->step(protocol::TimedReferee<AgentState>::Tick{
+                                         ros::WallTime::now().toSec(), markersPub_.getNumSubscribers() > 0,
+                                         lastCommandStep()}));
+                                   });
   ROS_INFO("monitor: timed mode: status every %g s from each agent's newest state; the Noether predictions do "
            "not hold in this mode (published as NaN)", scenario_.timeStep / rate_);
 }
 
-void TimedMonitor::tick() {
-  if (ended()) return;
-  const std::vector<FormationSnapshot> done = referee_->tick(ros::WallTime::now().toSec());
-  if (done.empty()) return;  // not every agent is there yet: the run has not started
-  for (const FormationSnapshot& s : done) {
-    publishSnapshot(s, stampOf(s.metrics.step), referee_->dataAge(), false);
+void TimedMonitor::carryOut(const protocol::RefereeReady& r) {
+  for (const FormationSnapshot& s : r.publish) publishSnapshot(s, stampOf(s.metrics.step), referee_->dataAge(), false);
+  if (ended()) return;  // a published step was blocked: that Ready ended the run
+  if (r.commandsAt >= 0) issueCommands(r.commandsAt);  // a goal's command (GoalServer) goes out at once
+  if (r.progress) {
+    if (r.starts) startedAt_ = ros::WallTime::now();
+    publishProgress(toMessage(referee_->progressNow()));
   }
-  if (ended()) return;  // a blocked formation ended the run (monitor_safety.cpp)
-  if (desk_->pending()) commandOffered();  // a goal's command (GoalServer): timed mode issues at once
-  // The progress starts the agents at the first tick (start by identity, as in lockstep); after
-  // that they ignore the window, and it says every quarter window how far the run is.
-  const long completed = completedStep(), last = scenario_.steps;
-  if (last > 0 && completed >= last) {
-    finish(RunProgress::FINISHED, "");
-    return;
-  }
-  const bool viewer = !waitForViewer_ || markersPub_.getNumSubscribers() > 0;
-  const bool starts = progress_.state == RunProgress::WAITING;
-  if (!(starts ? viewer : completed >= progress_.completed_step + std::max<long>(1, window_ / 4))) {
-    if (referee_->finished()) finish(RunProgress::FINISHED, "");
-    return;
-  }
-  if (starts) startedAt_ = ros::WallTime::now();
-  RunProgress next = progress_;
-  next.state = RunProgress::RUNNING;
-  next.completed_step = completed;
-  next.allowed_step = last > 0 ? std::min(completed + window_, last) : completed + window_;
-  next.converged_step = convergedStep_;
-  publishProgress(next);
-  if (referee_->finished()) finish(RunProgress::FINISHED, "");
+  if (r.finish) finish(referee_->progressNow());
 }
 
 void TimedMonitor::watch() {

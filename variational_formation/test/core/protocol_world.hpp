@@ -102,10 +102,7 @@ class World {
         recorderDo(recorder_.step(Recorder::MarkersArrived{msg.step, msg.step}));
         break;
       case Message::Kind::RecorderProgress:
-        if (monitor_) {
-          monitor_->recorderProgress(msg.step, msg.finished);
-          monitorUpdate();
-        }
+        if (monitor_) monitorDo(monitor_->step(Referee::RecorderReport{msg.step, msg.finished, "", true}));
         break;
     }
   }
@@ -325,7 +322,7 @@ class World {
       answers[i] = {true, agents_[i]->hasProgress(), heard.completedStep, heard.convergedStep};
       histories[i] = held(*agents_[i], static_cast<int>(i));
     }
-    monitor_->resume(answers, histories);
+    monitorDo(monitor_->step(Referee::Resume{answers, histories}));
     // Latched: the agents' newest states and the recorder's progress reach the new subscriber.
     for (const auto& l : latched_) send({Message::Kind::State, Message::Monitor, l.second, {}, -1, false, l.first});
     if (recorderReported_ >= 0) send({Message::Kind::RecorderProgress, Message::Monitor, {}, {}, recorderReported_, recorderFinished_, -1});
@@ -336,8 +333,11 @@ class World {
     const auto receipt = monitor_->offerState(i, s);
     if (receipt == FormationMonitor::Receipt::Accepted) monitorUpdate();
   }
-  void monitorUpdate() {
-    for (const FormationSnapshot& snap : monitor_->takeCompleted()) {
+  void monitorUpdate() { monitorDo(monitor_->step(Referee::Update{true})); }
+  /// Carries out what the monitor's referee said, as LockstepMonitor does: each published step is
+  /// checked against the centralised run and goes to the recorder; then the progress, the end.
+  void monitorDo(const Referee::Ready& r) {
+    for (const FormationSnapshot& snap : r.publish) {
       const long k = snap.metrics.step;
       if (!(snap.positions.array() == expected_[static_cast<std::size_t>(k)].array()).all()) {
         violations_.push_back("the monitor's step " + std::to_string(k) + " differs from the centralised run");
@@ -347,8 +347,8 @@ class World {
       latchedStatus_ = k;
       monitor_->keep(k, k);
     }
-    if (monitor_->updateProgress(true)) publishProgress();
-    if (monitor_->progressNow().state == Progress::State::Finished) finished_ = true;
+    if (r.progress || r.finish) publishProgress();  // the end goes out as the final progress
+    if (r.finish && monitor_->progressNow().state == Progress::State::Finished) finished_ = true;
   }
   void trace(const std::string& what) const {
     if (std::getenv("PROTOCOL_TRACE")) {

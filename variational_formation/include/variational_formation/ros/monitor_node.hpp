@@ -26,6 +26,7 @@
 #include "variational_formation_core/protocol/command_desk.hpp"
 #include "variational_formation_core/protocol/lockstep_referee.hpp"
 #include "variational_formation_core/protocol/timed_referee.hpp"
+#include "variational_formation_core/protocol/referee_ready.hpp"
 #include "variational_formation/ros/goal_server.hpp"
 #include "variational_formation/ros/service_call.hpp"
 #include "variational_formation/ros/state_batch.hpp"
@@ -91,6 +92,10 @@ class MonitorNode {
   /// A good command is pending in desk_: the mode issues it (lockstep at the allowed step, timed
   /// at once).
   virtual void commandOffered() = 0;
+  /// A failure the monitor found, or a blocked formation: the mode's referee decides the end, and
+  /// the mode carries out its Ready.
+  virtual void report(const protocol::Failure& failure) = 0;
+  virtual void report(const protocol::Blocked& blocked) = 0;
 
   // Live commands (src/ros/monitor_commands.cpp, doc/protocol.md "Commands").
   void setUpCommands(ros::NodeHandle& nh, ros::NodeHandle& pnh);
@@ -122,7 +127,8 @@ class MonitorNode {
   void onReconfigure(variational_formation::FormationConfig& config, uint32_t level);
 
   /// Publishes one completed step's status and markers (and /clock), stamped `stamp`; tracks the
-  /// congruent stretch for the result. @return what was published, for the recorder gate.
+  /// congruent stretch for the result; reports a formation it finds blocked (report(Blocked)).
+  /// @return what was published, for the recorder gate.
   Published publishSnapshot(const FormationSnapshot& s, const ros::Time& stamp, double dataAge, bool noetherHolds);
   // The safety filter as the monitor sees it (src/ros/monitor_safety.cpp, doc/ros_api.md
   // "monitor"): min_separation and constraints_active in every status, the closest approach and
@@ -145,10 +151,12 @@ class MonitorNode {
   /// Agent `agent` was heard (from `publisher`: its node or its manager).
   void heard(int agent, const std::string& publisher);
   void drop(int agent, const std::string& why);
+  /// @return false once `p` has been gone longer than `timeout` [s] (reported as a Failure).
   bool checkAlive(Participant& p, const std::string& what, double timeout);
   void reportWaiting(const std::string& line);
-  /// Ends the run once (finished may turn into failed when the scenario requires convergence).
-  void finish(uint8_t state, std::string reason);
+  /// Carries out a Ready's end (RefereeReady::finish): the referee's end `end`, once (finished may
+  /// turn into failed when the scenario requires convergence).
+  void finish(const protocol::Progress& end);
   bool ended() const { return exitStatus_ >= 0; }
   static std::string agentList(const std::vector<int>& ids) {
     return protocol::LockstepReferee<AgentState, Published>::agentList(ids);
@@ -245,7 +253,7 @@ class LockstepMonitor : public MonitorNode {
  private:
   using Referee = protocol::LockstepReferee<AgentState, Published>;
   bool offer(int agent, const AgentState& msg, const std::string& publisher) override;
-  void afterAccepted() override { publishCompleted(); }
+  void afterAccepted() override { updateProgress(); }
   void begin() override;
   void watch() override;
   std::string waitingFor() const override { return referee_->waitingFor(recorder_.node); }
@@ -254,12 +262,16 @@ class LockstepMonitor : public MonitorNode {
   void measureUnder(const CommandSchedule& schedule) override { referee_->setSchedule(schedule); }
   ros::Time stampOf(long step) const override { return ros::Time(std::max(0L, step) * scenario_.timeStep); }
   void commandOffered() override { updateProgress(); }  // issued at the allowed step, then counted
+  void report(const protocol::Failure& failure) override { carryOut(referee_->step(failure)); }
+  void report(const protocol::Blocked& blocked) override { carryOut(referee_->step(blocked)); }
   void onRecorderProgress(const ros::MessageEvent<RunProgress const>& event);
   bool onRecall(RecallState::Request& request, RecallState::Response& response);
   bool onHistory(RecallHistory::Request& request, RecallHistory::Response& response);
-  /// Each completed step, then the progress.
-  void publishCompleted();
-  void updateProgress();
+  /// The referee's Update: each completed step, then the progress.
+  void updateProgress() { carryOut(referee_->step(Referee::Update{viewer()})); }
+  bool viewer() const { return markersPub_.getNumSubscribers() > 0; }
+  /// Does what `r` says, in its order (RefereeReady).
+  void carryOut(const Referee::Ready& r);
   /// The states agents `ids` hold of themselves (`~history`), in order of `ids`.
   std::vector<RecallHistory::Response> fetchHistories(const std::vector<int>& ids);
   void catchUpFromNeighbours(const std::vector<int>& ids);
@@ -292,7 +304,12 @@ class TimedMonitor : public MonitorNode {
   ros::Time stampOf(long) const override { return ros::Time::now(); }
   /// Timed agents apply the newest command at their next tick: issued at once.
   void commandOffered() override;
-  void tick();
+  void report(const protocol::Failure& failure) override { carryOut(referee_->step(failure)); }
+  void report(const protocol::Blocked& blocked) override { carryOut(referee_->step(blocked)); }
+  /// The stamp of the newest issued command (-1: none).
+  long lastCommandStep() const { return desk_->issued().empty() ? -1 : desk_->issued().back().first; }
+  /// Does what `r` says, in its order (RefereeReady).
+  void carryOut(const protocol::RefereeReady& r);
 
   std::unique_ptr<protocol::TimedReferee<AgentState>> referee_;
   double rate_ = 0.0;

@@ -12,6 +12,7 @@
 #include "variational_formation_core/agents/formation_monitor.hpp"
 #include "variational_formation_core/protocol/progress.hpp"
 #include "variational_formation_core/protocol/recovery.hpp"
+#include "variational_formation_core/protocol/referee_ready.hpp"
 
 namespace vf::protocol {
 
@@ -20,7 +21,8 @@ namespace vf::protocol {
  * the protocol. It takes events (a state from an agent or from a history, the recorder's
  * progress, a participant's failure, a tick that may see a viewer) and says what to do: the
  * completed steps to publish, the progress to publish, whether the run finished or failed, which
- * agents to catch up from, and what it waits for.
+ * agents to catch up from, and what it waits for. The events that change the run's course go to
+ * step(), which returns a RefereeReady: what to do, in order.
  *
  * - Start by identity: the run starts once every agent's step 0 is complete (and recorded, and
  *   watched by a viewer if one is awaited).
@@ -30,6 +32,8 @@ namespace vf::protocol {
  * - Recorder gate: accepted states and published steps are kept until the recorder confirms
  *   them, to be served again (`~history`) or republished.
  * - Restart: resume() goes on from the newest progress any agent heard.
+ * - Failures: every end of the run is its decision (step(Failure), step(Blocked), the recorder's
+ *   failure, the last step); the node finishes only when a Ready says so.
  *
  * State is the caller's message type with fields step, position and previous_position; Published
  * is what it publishes per completed step (kept for the recorder).
@@ -78,7 +82,66 @@ class LockstepReferee {
   /// Ends the run as failed (an agent's failure, a participant gone, the recorder failed).
   void fail(const std::string& reason) { end(Progress::State::Failed, reason); }
 
-  /// Completed steps in order, each once: publish them, then keep(), then call progress().
+  using Ready = RefereeReady;
+  /// The node looks again (a state was accepted, a catch-up, its watch, a command, a viewer):
+  /// `viewer` says whether one listens on the markers (if one is awaited).
+  struct Update {
+    bool viewer;
+  };
+  /// The recorder's progress: it holds every step up to `completedStep`, or it failed (`failure`).
+  struct RecorderReport {
+    long completedStep;
+    bool finished;
+    std::string failure;
+    bool viewer;
+  };
+  /// A restarted monitor's first event: what each agent heard and holds (resume()).
+  struct Resume {
+    std::vector<ProgressAnswer> progress;
+    std::vector<std::vector<State>> histories;
+  };
+
+  /**
+   * The completed steps to publish, then whether the progress changed (start by identity, the
+   * flow window, the recorder gate, the end at the last step), and the step to issue a pending
+   * command at: the allowed step, but past every step whose status is out (a status counts every
+   * command stamped at or before its step, so the recorder knows which commands a step waits for;
+   * the allowed step equals the completed one while the agents wait for a lagging recorder).
+   */
+  Ready step(const Update& e) {
+    Ready r;
+    r.publish = takeCompleted();
+    if (ended()) return r;
+    const bool waiting = progress_.state == Progress::State::Waiting;
+    r.progress = updateProgress(e.viewer);
+    if (ended()) {
+      r.progress = false;
+      r.finish = true;
+      return r;
+    }
+    const long published = completedStep(), last = monitor_->scenario().steps;
+    r.commandsAt = (last <= 0 || published < last) ? std::max(progress_.allowedStep, published + 1) : progress_.allowedStep;
+    r.starts = waiting && running();
+    return r;
+  }
+  Ready step(const RecorderReport& e) {
+    if (!e.failure.empty()) return step(Failure{"the recorder failed: " + e.failure});
+    recorderProgress(e.completedStep, e.finished);
+    return step(Update{e.viewer});
+  }
+  Ready step(const Failure& e) { return endRun(progress_, Progress::State::Failed, e.reason); }
+  Ready step(const Blocked&) { return endRun(progress_, Progress::State::Finished, ""); }
+  /// Finishes a run that was already over (it fails: it did not witness it); after a resume,
+  /// running() is true and the steps it rebuilt come with the next Update.
+  Ready step(const Resume& e) {
+    const bool wasOver = ended();
+    resume(e.progress, e.histories);
+    Ready r;
+    r.finish = !wasOver && ended();
+    return r;
+  }
+
+  /// Completed steps in order, each once (step(Update) hands them out with the progress).
   std::vector<FormationSnapshot> takeCompleted() {
     std::vector<FormationSnapshot> done = monitor_->takeCompleted();
     for (const FormationSnapshot& s : done) {
@@ -202,11 +265,7 @@ class LockstepReferee {
   void setSchedule(const CommandSchedule& schedule) { monitor_->setSchedule(schedule); }
 
  private:
-  void end(Progress::State state, const std::string& reason) {
-    if (ended()) return;
-    progress_.state = state;
-    progress_.reason = reason;
-  }
+  void end(Progress::State state, const std::string& reason) { endRun(progress_, state, reason); }
 
   std::unique_ptr<FormationMonitor> monitor_;
   long window_;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "variational_formation_core/agents/formation_monitor.hpp"
+#include "variational_formation_core/protocol/referee_ready.hpp"
 
 namespace vf::protocol {
 
@@ -17,15 +18,27 @@ namespace vf::protocol {
  * state is there and ends once every agent reached the scenario's last step. A respawned agent
  * may restart from a lower step once its old state is `staleAfter` seconds old.
  *
+ * Each tick and each failure goes to step(), which returns a RefereeReady: what to do, in order.
+ * - Start by identity: the first progress goes out at the first tick that measured every agent
+ *   (and once a viewer listens, if one is awaited); it lets the agents go.
+ * - Throttling: after that the agents ignore the window, and a progress says every quarter window
+ *   (at least every tick) how far the run is.
+ * - The end: the tick that reaches the scenario's last step, or at which every agent reached it,
+ *   finishes the run; a failure (step(Failure)) or a blocked formation (step(Blocked)) ends it.
+ *
  * State is the caller's message type with fields step, position and previous_position; times
  * are the caller's clock in seconds.
  */
 template <class State>
 class TimedReferee {
  public:
-  TimedReferee(const Scenario& scenario, double staleAfter)
+  /// @param staleAfter [s] (see above); @param window ~window (>= 1, the progress period is a
+  /// quarter of it); @param waitForViewer ~wait_for_viewer.
+  TimedReferee(const Scenario& scenario, double staleAfter, long window = 100, bool waitForViewer = false)
       : monitor_(std::make_unique<FormationMonitor>(scenario)),
         staleAfter_(staleAfter),
+        window_(window),
+        waitForViewer_(waitForViewer),
         newest_(static_cast<std::size_t>(scenario.agentCount())),
         receivedAt_(static_cast<std::size_t>(scenario.agentCount()), 0.0),
         held_(static_cast<std::size_t>(scenario.agentCount()), false) {}
@@ -66,6 +79,45 @@ class TimedReferee {
     finished_ = allDone;
     return monitor_->takeCompleted();
   }
+  using Ready = RefereeReady;
+  /// The status clock ticks at `now` [s]; `viewer`: one listens on the markers (if one is
+  /// awaited); `lastCommandStep`: the stamp of the newest issued command (-1: none).
+  struct Tick {
+    double now;
+    bool viewer;
+    long lastCommandStep;
+  };
+  /// Measures the tick (tick()), then: a pending command goes out at once (commandStep), and the
+  /// progress and the end as the class comment says. Nothing after the end.
+  Ready step(const Tick& e) {
+    Ready r;
+    if (ended()) return r;
+    r.publish = tick(e.now);
+    if (r.publish.empty()) return r;  // not every agent is there yet: the run has not started
+    convergedStep_ = r.publish.back().converged ? r.publish.back().convergedStep : -1;
+    r.commandsAt = commandStep(e.lastCommandStep);
+    const long completed = completedStep(), last = monitor_->scenario().steps;
+    if (last > 0 && completed >= last) return finishInto(r);
+    const bool starts = progress_.state == Progress::State::Waiting;
+    if (starts ? (e.viewer || !waitForViewer_) : completed >= progress_.completedStep + std::max<long>(1, window_ / 4)) {
+      progress_.state = Progress::State::Running;
+      progress_.completedStep = completed;
+      progress_.allowedStep = last > 0 ? std::min(completed + window_, last) : completed + window_;
+      progress_.convergedStep = convergedStep_;
+      r.progress = true;
+      r.starts = starts;
+    }
+    return finished_ ? finishInto(r) : r;
+  }
+  Ready step(const Failure& e) { return endRun(progress_, Progress::State::Failed, e.reason); }
+  Ready step(const Blocked&) { return endRun(progress_, Progress::State::Finished, ""); }
+  /// The stamp of a command issued now: after the latest tick and after the newest issued command
+  /// (`lastCommandStep`, -1: none); the agents take the newest.
+  long commandStep(long lastCommandStep) const { return std::max(completedStep() + 1, lastCommandStep + 1); }
+  /// The progress as published last (Waiting before the start), or the end.
+  const Progress& progressNow() const { return progress_; }
+  bool ended() const { return over(progress_); }
+
   /// Every agent reached the last step (at the latest tick).
   bool finished() const { return finished_; }
   /// Agents heard before whose newest state is older than staleAfter at `now` (dead or stopped?).
@@ -96,8 +148,17 @@ class TimedReferee {
   void setSchedule(const CommandSchedule& schedule) { monitor_->setSchedule(schedule); }
 
  private:
+  Ready& finishInto(Ready& r) {
+    r.finish = endRun(progress_, Progress::State::Finished, "").finish;
+    return r;
+  }
+
   std::unique_ptr<FormationMonitor> monitor_;
   double staleAfter_;
+  long window_;
+  bool waitForViewer_;
+  Progress progress_;
+  long convergedStep_ = -1;  // first step of the congruent stretch at the latest tick (-1: none)
   std::vector<State> newest_;
   std::vector<double> receivedAt_;
   std::vector<bool> held_;
