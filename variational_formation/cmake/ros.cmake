@@ -1,15 +1,19 @@
 # The ROS layer: thin nodes over the core, plus rostests.
-add_library(variational_formation_ros src/ros/agent_commands.cpp src/ros/agent_node.cpp src/ros/agent_recovery.cpp src/ros/markers.cpp
+add_library(variational_formation_ros
+  src/ros/agent_commands.cpp
+  src/ros/agent_node.cpp
+  src/ros/agent_recovery.cpp
+  src/ros/formation_subscriptions.cpp
+  src/ros/frames.cpp
+  src/ros/liveness.cpp
+  src/ros/markers.cpp
   src/ros/monitor_node.cpp
   src/ros/output_files.cpp
   src/ros/participant_names.cpp
-  src/ros/frames.cpp
-  src/ros/shared_scenario.cpp
-  src/ros/formation_subscriptions.cpp
-  src/ros/recalled.cpp
-  src/ros/liveness.cpp
   src/ros/progress_message.cpp
-  src/ros/recorder_node.cpp)
+  src/ros/recalled.cpp
+  src/ros/recorder_node.cpp
+  src/ros/shared_scenario.cpp)
 # The time-driven agent (doc/robots.md), selected by the agent's ~mode.
 target_sources(variational_formation_ros PRIVATE src/ros/timed_agent_node.cpp src/ros/timed_agent_outputs.cpp
   src/ros/timed_agent_robot.cpp)

@@ -5,6 +5,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "variational_formation_core/common/invalid_input.hpp"
+
 namespace vf {
 
 namespace {

@@ -7,7 +7,7 @@ headers alone do not bring. The types are found in the code, not listed by hand:
 - the topics a library the nodes use publishes for them (tf2_ros, diagnostic_updater,
   dynamic_reconfigure, roscpp's /rosout), found by the library's header,
 - the types the Python scripts import (`from pkg.msg import A, B`),
-- the package's own msg/ and srv/.
+- the messages package's msg/ and srv/ (variational_formation_msgs, beside this package).
 """
 import glob
 import os
@@ -21,6 +21,8 @@ from roslib.message import get_message_class, get_service_class
 # msg module, and would hide the built one that rostopic finds.
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
 PKG = "variational_formation"
+MSGS = "variational_formation_msgs"
+MSGS_DIR = os.path.join(os.path.dirname(REPO), MSGS)
 # A library header the nodes include, and the types that library publishes or serves for them.
 LIBRARY_TYPES = {
     "tf2_ros/transform_broadcaster.h": ["tf2_msgs/TFMessage"],
@@ -62,18 +64,19 @@ class MessageClassesTest(unittest.TestCase):
             for package, names in re.findall(r'^\s*from\s+(\w+)\.msg\s+import\s+([\w, ]+)', text, re.M):
                 for name in names.replace(" ", "").split(","):
                     messages.setdefault(f"{package}/{name}", where)
-        for path in sorted(glob.glob(os.path.join(REPO, "msg", "*.msg"))):
-            messages.setdefault(f"{PKG}/{os.path.basename(path)[:-4]}", "msg/")
-        services = {f"{PKG}/{os.path.basename(p)[:-4]}": "srv/" for p in glob.glob(os.path.join(REPO, "srv", "*.srv"))}
+        for path in sorted(glob.glob(os.path.join(MSGS_DIR, "msg", "*.msg"))):
+            messages.setdefault(f"{MSGS}/{os.path.basename(path)[:-4]}", f"{MSGS}/msg/")
+        services = {f"{MSGS}/{os.path.basename(p)[:-4]}": f"{MSGS}/srv/"
+                    for p in glob.glob(os.path.join(MSGS_DIR, "srv", "*.srv"))}
         return messages, services
 
     def test_the_search_finds_the_nodes_topics(self):
         messages, services = self.found_types()
         for kind in ("visualization_msgs/MarkerArray", "nav_msgs/Odometry", "geometry_msgs/Twist",
                      "tf2_msgs/TFMessage", "diagnostic_msgs/DiagnosticArray", "std_msgs/Float64",
-                     "rosgraph_msgs/Clock", f"{PKG}/FormationStatus", f"{PKG}/AgentState"):
+                     "rosgraph_msgs/Clock", f"{MSGS}/FormationStatus", f"{MSGS}/AgentState"):
             self.assertIn(kind, messages)
-        self.assertIn(f"{PKG}/RecallState", services)
+        self.assertIn(f"{MSGS}/RecallState", services)
 
     def test_every_type_loads_in_python(self):
         messages, services = self.found_types()
