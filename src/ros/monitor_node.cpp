@@ -7,6 +7,7 @@
 
 #include "variational_formation/core/number_checks.hpp"
 #include "variational_formation/core/scenario.hpp"
+#include "variational_formation/ros/markers.hpp"
 #include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/participants.hpp"
@@ -39,6 +40,7 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh, bool timed) 
   scenario_ = loadScenario(path_);
   const int n = scenario_.agentCount();
   trails_ = Trails(n, trailLength_);
+  allMarkersEvery_ = allMarkersEvery(trails_.stride(), scenario_.timeStep);
   if (!resultFile_.empty()) {
     createParentDirectory(resultFile_, "~result_file");
     announceReplacedResult(resultFile_);

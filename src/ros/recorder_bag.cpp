@@ -23,6 +23,7 @@ void RecorderNode::openPart() {
   }
   try {
     bag_.open(path, rosbag::bagmode::Write);
+    bag_.setCompression(rosbag::compression::LZ4);
     open_ = true;
   } catch (const std::exception& e) {
     throw InvalidInput("~bag: cannot write '" + path + "': " + e.what());
