@@ -132,27 +132,31 @@ Marker commandArrow(const Ghost& ghostAt, double radius, const ros::Time& stamp)
   return m;
 }
 
-/// The agents as one sphere list (a sphere of its colour at each q_i), and their trails as one
-/// line list: per agent, segments through its kept positions (Trails) and on to q_i, in its
-/// colour. Two markers whatever the agent count: rviz draws the same spheres and lines as a
-/// marker per agent would, from a message a few times smaller.
-void addAgentsAndTrails(const FormationSnapshot& s, const Trails& trails, double radius, const ros::Time& stamp,
-                        visualization_msgs::MarkerArray& out) {
-  const int n = trails.agents();
+/// The agents as one sphere list (a sphere of its colour at each q_i): one marker whatever the
+/// agent count, the same spheres rviz would draw from a marker per agent.
+Marker agentSpheres(const FormationSnapshot& s, int n, double radius, const ros::Time& stamp) {
   Marker agents = base("agents", 0, Marker::SPHERE_LIST, stamp);
   agents.scale.x = agents.scale.y = agents.scale.z = 2.0 * radius;
   agents.color = rgba(1.0, 1.0, 1.0, 1.0);  // rviz takes colors[] per point
   agents.points.reserve(static_cast<std::size_t>(n));
   agents.colors.reserve(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    agents.points.push_back(point(column3(s.positions, i)));
+    agents.colors.push_back(agentColour(i));
+  }
+  return agents;
+}
+
+/// The trails as one line list: per agent, segments through its kept positions (Trails) and on
+/// to q_i, in its colour, faded.
+Marker trailLines(const FormationSnapshot& s, const Trails& trails, double radius, const ros::Time& stamp) {
+  const int n = trails.agents();
   Marker lines = base("trails", 0, Marker::LINE_LIST, stamp);
   lines.scale.x = 0.25 * radius;
   lines.color = rgba(1.0, 1.0, 1.0, 0.6);
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d q = column3(s.positions, i);
-    const std_msgs::ColorRGBA colour = agentColour(i);
-    agents.points.push_back(point(q));
-    agents.colors.push_back(colour);
-    std_msgs::ColorRGBA faded = colour;
+    std_msgs::ColorRGBA faded = agentColour(i);
     faded.a = 0.6f;
     const std::deque<Eigen::Vector3d>& kept = trails.of(i);
     const Eigen::Vector3d* from = kept.empty() ? &q : &kept.front();
@@ -169,14 +173,14 @@ void addAgentsAndTrails(const FormationSnapshot& s, const Trails& trails, double
     // On to the current position (none if it is the last kept one; a dot at the start).
     if (*from != q || kept.size() < 2) segment(*from, q);
   }
-  out.markers.push_back(agents);
-  out.markers.push_back(lines);
+  return lines;
 }
 
-/// The edges, green (no error) to red (|error| >= 10% of s d_ij, s the commanded scale), and the
-/// desired shape's edges as a faint ghost; nothing without edges.
+/// The edges, green (no error) to red (|error| >= 10% of s d_ij, s the commanded scale), and, with
+/// `ghostToo`, the desired shape's edges as a faint ghost; nothing without edges.
 void addEdgesAndGhostEdges(const FormationSnapshot& s, const Formation& formation, const Ghost& ghostAt,
-                           double radius, const ros::Time& stamp, visualization_msgs::MarkerArray& out) {
+                           double radius, const ros::Time& stamp, bool ghostToo,
+                           visualization_msgs::MarkerArray& out) {
   Marker edges = base("edges", 0, Marker::LINE_LIST, stamp);
   edges.scale.x = 0.3 * radius;
   edges.color = rgba(0.2, 0.8, 0.2, 1.0);
@@ -193,12 +197,12 @@ void addEdgesAndGhostEdges(const FormationSnapshot& s, const Formation& formatio
     for (int end : {edge.tail, edge.head}) {
       edges.points.push_back(point(column3(s.positions, end)));
       edges.colors.push_back(c);
-      ghost.points.push_back(ghostAt.agent(formation, end));
+      if (ghostToo) ghost.points.push_back(ghostAt.agent(formation, end));
     }
   }
   if (!edges.points.empty()) {
     out.markers.push_back(edges);
-    out.markers.push_back(ghost);
+    if (ghostToo) out.markers.push_back(ghost);
   }
 }
 
@@ -232,17 +236,24 @@ Marker statusText(const FormationSnapshot& s, int agents, const Ghost& ghostAt, 
 
 }  // namespace
 
+long allMarkersEvery(int trailStride, double timeStep) {
+  const long perRedraw = static_cast<long>(std::ceil(kAllMarkersPeriod / timeStep - 1e-9));
+  return std::max({static_cast<long>(trailStride), perRedraw, 1L});
+}
+
 visualization_msgs::MarkerArray makeMarkers(const FormationSnapshot& s, const Formation& formation,
                                             const Trails& trails, const CommandSchedule* schedule,
-                                            double timeStep) {
+                                            double timeStep, MarkerParts parts) {
   visualization_msgs::MarkerArray out;
   const ros::Time stamp = ros::Time::now();
   const int n = formation.agentCount();
   const double radius = markerRadius(formation);
   const Ghost ghostAt(s, formation, schedule, timeStep);
-  addAgentsAndTrails(s, trails, radius, stamp, out);
-  addEdgesAndGhostEdges(s, formation, ghostAt, radius, stamp, out);
-  out.markers.push_back(ghostAgents(formation, ghostAt, radius, stamp));
+  const bool all = parts == MarkerParts::All;
+  out.markers.push_back(agentSpheres(s, n, radius, stamp));
+  if (all) out.markers.push_back(trailLines(s, trails, radius, stamp));
+  addEdgesAndGhostEdges(s, formation, ghostAt, radius, stamp, all, out);
+  if (all) out.markers.push_back(ghostAgents(formation, ghostAt, radius, stamp));
   out.markers.push_back(statusText(s, n, ghostAt, radius, stamp));
   if (schedule) out.markers.push_back(commandArrow(ghostAt, radius, stamp));
   return out;

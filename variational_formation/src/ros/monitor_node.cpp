@@ -7,11 +7,11 @@
 
 #include "variational_formation_core/common/number_checks.hpp"
 #include "variational_formation_core/model/scenario.hpp"
+#include "variational_formation/ros/markers.hpp"
 #include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/frames.hpp"
 #include "variational_formation/ros/liveness.hpp"
-#include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/participant_names.hpp"
 
 namespace vf {
@@ -42,6 +42,7 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh, bool timed) 
   scenario_ = loadScenario(path_);
   const int n = scenario_.agentCount();
   trails_ = Trails(n, trailLength_);
+  allMarkersEvery_ = allMarkersEvery(trails_.stride(), scenario_.timeStep);
   if (!resultFile_.empty()) {
     createParentDirectory(resultFile_, "~result_file");
     announceReplacedResult(resultFile_);

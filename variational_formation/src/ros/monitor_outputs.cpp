@@ -47,11 +47,16 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
   }
   // Markers cost O(n + |E|) per step (trails thinned to a bound, Trails): built only when someone
   // takes them (the recorder, a viewer), every marker_every steps, and always at the first and
-  // last step so that the latched one is right. The trails above still get every step.
-  const long last = scenario_.steps;
-  const bool edge = s.metrics.step == 0 || (last > 0 && s.metrics.step == last);
-  if (edge || (s.metrics.step % markerEvery_ == 0 && (recording_ || markersPub_.getNumSubscribers() > 0))) {
-    out.second = makeMarkers(s, measure().formation(), trails_, commandSchedule(), scenario_.timeStep);
+  // last step so that the latched one is right. The trails above still get every step. The
+  // trails and the ghost, most of an array's bytes, come every allMarkersEvery_ steps only (and
+  // at the first and last step): rviz keeps the last ones it got.
+  const long step = s.metrics.step, last = scenario_.steps;
+  const bool edge = step == 0 || (last > 0 && step == last);
+  if (edge || (step % markerEvery_ == 0 && (recording_ || markersPub_.getNumSubscribers() > 0))) {
+    const bool all = edge || allMarkersStep_ < 0 || step < allMarkersStep_ || step - allMarkersStep_ >= allMarkersEvery_;
+    if (all) allMarkersStep_ = step;
+    out.second = makeMarkers(s, measure().formation(), trails_, commandSchedule(), scenario_.timeStep,
+                             all ? MarkerParts::All : MarkerParts::Moving);
     if (scenario_.safety) addSafetyMarkers(s, *scenario_.safety, scenario_.obstacles, out.second);
     for (auto& m : out.second.markers) {
       m.header.stamp = stamp;

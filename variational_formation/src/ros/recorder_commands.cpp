@@ -9,7 +9,6 @@
 #include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/formation_subscriptions.hpp"
-#include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/participant_names.hpp"
 #include "variational_formation/ros/recorder_node.hpp"
 

@@ -9,7 +9,6 @@
 #include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/frames.hpp"
-#include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/participant_names.hpp"
 #include "variational_formation/ros/progress_message.hpp"
 #include "variational_formation/ros/service_call.hpp"

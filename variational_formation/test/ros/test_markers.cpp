@@ -210,5 +210,37 @@ TEST_F(MarkersTest, TheArrayHasAFixedHandfulOfMarkersAndGrowsLinearlyWithTheAgen
   EXPECT_LT(bytes, 500000u);
 }
 
+TEST_F(MarkersTest, MovingPartsLeaveOutTheTrailsAndTheGhostOnly) {
+  const int n = 100;
+  const Formation f = ring(n);
+  Trails trails(n, 100);
+  const auto all = markersAfter(f, 40, trails);
+  const auto moving = makeMarkers(snapshotAt(f, 40), f, trails, nullptr, 0.005, MarkerParts::Moving);
+  std::vector<std::pair<std::string, int>> names;
+  for (const Marker& m : moving.markers) names.emplace_back(m.ns, m.id);
+  const std::vector<std::pair<std::string, int>> want{{"agents", 0}, {"edges", 0}, {"text", 0}};
+  EXPECT_EQ(names, want);
+  // What it holds is what the whole array holds, point for point.
+  for (const auto& [ns, id] : want) {
+    const Marker& a = find(all, ns, id);
+    const Marker& b = find(moving, ns, id);
+    EXPECT_EQ(a.points, b.points) << ns;
+    EXPECT_EQ(a.colors, b.colors) << ns;
+    EXPECT_EQ(a.text, b.text) << ns;
+  }
+  // Under half the bytes: the trails and the ghost are most of a 100-agent ring's array.
+  EXPECT_LT(2 * ros::serialization::serializationLength(moving), ros::serialization::serializationLength(all));
+}
+
+TEST_F(MarkersTest, WholeArraysComeAsOftenAsTheTrailsGrowAndAtMost25ASimulatedSecond) {
+  EXPECT_EQ(allMarkersEvery(1, 0.005), 8);   // 0.04 s / 0.005 s
+  EXPECT_EQ(allMarkersEvery(1, 0.014), 3);   // ceil(2.86)
+  EXPECT_EQ(allMarkersEvery(1, 0.04), 1);    // exactly one step
+  EXPECT_EQ(allMarkersEvery(1, 0.1), 1);
+  EXPECT_EQ(allMarkersEvery(17, 0.005), 17);  // 100 agents: the trails' stride
+  EXPECT_EQ(allMarkersEvery(50, 0.001), 50);
+  EXPECT_EQ(allMarkersEvery(1, 0.0001), 400);
+}
+
 }  // namespace
 }  // namespace vf

@@ -24,6 +24,23 @@ std_msgs::ColorRGBA agentColour(int agent);
 /// Status message of a snapshot.
 FormationStatus toStatusMessage(const FormationSnapshot& snapshot);
 
+/// Which markers a step's array holds: all of them, or only those that move with the agents at
+/// every step (agents, edges, text, command arrow). rviz keeps drawing the trails and the ghost of
+/// the last array that held them (a marker stays until replaced or deleted).
+enum class MarkerParts { All, Moving };
+
+/// Simulated seconds between two arrays with every marker, at least: 25 a simulated second, as
+/// often as rviz redraws (doc/benchmarks.md, "Recording and pacing").
+constexpr double kAllMarkersPeriod = 0.04;
+
+/**
+ * Steps between two arrays with every marker (the trails and the ghost, the bulk of an array):
+ * max(stride, ceil(kAllMarkersPeriod / h)), so that an array with trails comes about as often as
+ * the trails gain a position, and never much more often than rviz redraws.
+ * @param trailStride Trails::stride(). @param timeStep h [s] (> 0).
+ */
+long allMarkersEvery(int trailStride, double timeStep);
+
 /**
  * rviz markers of a snapshot in frame world, a fixed handful of markers whatever the agent count:
  * the agents (ns `agents`, one SPHERE_LIST: a sphere per agent at q_i, in agentColour(i)), the
@@ -36,10 +53,12 @@ FormationStatus toStatusMessage(const FormationSnapshot& snapshot);
  * an arrow from the centroid shows v*.
  * @param trails the agents' recent positions (one trail per agent of the formation).
  * @param schedule the commands the agents apply, or nullptr. @param timeStep h [s].
+ * @param parts MarkerParts::Moving leaves out the trails and the ghost (ns `trails` and
+ * `desired_shape`).
  */
 visualization_msgs::MarkerArray makeMarkers(const FormationSnapshot& snapshot, const Formation& formation,
                                             const Trails& trails, const CommandSchedule* schedule = nullptr,
-                                            double timeStep = 0.0);
+                                            double timeStep = 0.0, MarkerParts parts = MarkerParts::All);
 
 /**
  * The safety filter's markers (a scenario with `safety:`), appended to `out`: per agent its safety

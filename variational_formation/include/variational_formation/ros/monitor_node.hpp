@@ -226,6 +226,8 @@ class MonitorNode {
   Trails trails_{1, 2};  // replaced once the scenario is read
   int trailLength_ = 100;
   long markerEvery_ = 1;
+  long allMarkersEvery_ = 1;   // steps between arrays with the trails and the ghost (allMarkersEvery)
+  long allMarkersStep_ = -1;   // the step of the last such array published
   std::string resultFile_;
   double finalError_ = 0.0;  // max distance error at the last completed step [m]
   ShapeFindings lastShape_;  // at the newest completed step (noteShape)
