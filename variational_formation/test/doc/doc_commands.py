@@ -9,7 +9,7 @@ import shlex
 import subprocess
 import xml.etree.ElementTree as ElementTree
 
-ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
 # The repository, which holds README.md, doc/ and the three packages (ROOT is variational_formation's).
 REPOSITORY = os.path.dirname(ROOT)
 PKG = "variational_formation"

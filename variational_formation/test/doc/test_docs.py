@@ -33,7 +33,7 @@ import unittest
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import doc_commands  # noqa: E402
 
-ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
 # The repository, which holds README.md, doc/ and the three packages (ROOT is variational_formation's).
 REPOSITORY = os.path.dirname(ROOT)
 API = os.path.join(REPOSITORY, "doc", "ros_api.md")
