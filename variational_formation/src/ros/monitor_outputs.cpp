@@ -2,12 +2,14 @@
 // /clock, and at the end the result file and the final progress (MonitorNode, monitor_node.hpp).
 #include <fstream>
 #include <limits>
+#include <sstream>
 
 #include <rosgraph_msgs/Clock.h>
 
 #include "variational_formation_core/agents/run_verdict.hpp"
 #include "variational_formation/ros/markers.hpp"
 #include "variational_formation/ros/monitor_node.hpp"
+#include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/progress_message.hpp"
 
 namespace vf {
@@ -80,17 +82,21 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
 
 void MonitorNode::writeResult(const std::string& result, const std::string& reason) const {
   if (resultFile_.empty()) return;
-  std::ofstream f(resultFile_);
-  std::string quoted;
-  for (char c : reason) quoted += c == '"' ? std::string("\\\"") : std::string(1, c);
+  auto quoted = [](const std::string& text) {
+    std::string out = "\"";
+    for (char c : text) out += c == '"' ? std::string("\\\"") : std::string(1, c);
+    return out + "\"";
+  };
   const ShapeOutcome formation = shapeVerdict();
+  std::ostringstream f;
   f << "result: " << result << "\nscenario: " << scenario_.name << "\nsteps: " << scenario_.steps
     << "\ncompleted_step: " << completedStep() << "\nconverged_step: " << formation.convergedStep
-    << "\nshape_error: " << formation.findings.shapeError << "\nformation: \""
-    << formation.line << "\"\nfinal_max_distance_error: " << finalError_ << "\ndropped: " << dropped_ << "\ncommands: " << commandsIssued()
+    << "\nshape_error: " << formation.findings.shapeError << "\nformation: "
+    << quoted(formation.line) << "\nfinal_max_distance_error: " << finalError_ << "\ndropped: " << dropped_ << "\ncommands: " << commandsIssued()
     << "\ncommands_refused: " << commandsRefused_ << "\ncommands_saturated: " << desk_->saturated()
-    << "\nreason: \"" << quoted << "\"\n" << safetyResultLines() << robotsResultLines();
-  if (!f) ROS_ERROR("monitor: cannot write the result file %s", resultFile_.c_str());
+    << "\nreason: " << quoted(reason) << "\n" << safetyResultLines() << robotsResultLines();
+  // Whole or not at all: a test or script polling the file never reads half of it.
+  if (!replaceFileWith(resultFile_, f.str())) ROS_ERROR("monitor: cannot write the result file %s", resultFile_.c_str());
 }
 
 void MonitorNode::finish(const protocol::Progress& end) {

@@ -1,8 +1,6 @@
 #include "variational_formation/ros/mujoco_world_node.hpp"
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include <nav_msgs/Odometry.h>
 #include <rosgraph_msgs/Clock.h>
@@ -243,15 +241,7 @@ void MujocoWorldNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
 void MujocoWorldNode::appendResult() {
   if (resultFile_.empty() || resultWritten_) return;
   // The monitor writes the file before it says the run is over; the world adds its lines.
-  std::ifstream in(resultFile_);
-  std::stringstream text;
-  text << in.rdbuf();
-  const std::string body = text.str();
-  if (body.find("result: ") == std::string::npos || body.find("result: running") != std::string::npos) return;
-  std::ofstream out(resultFile_, std::ios::app);
-  out << world_->contacts().resultLines();
-  resultWritten_ = static_cast<bool>(out);
-  if (!resultWritten_) ROS_ERROR("%s: cannot add the contacts to %s", ros::this_node::getName().c_str(), resultFile_.c_str());
+  resultWritten_ = appendToResult(resultFile_, world_->contacts().resultLines()) != Appended::notYet;
 }
 
 }  // namespace vf

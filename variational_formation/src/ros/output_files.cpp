@@ -40,15 +40,25 @@ void announceReplacedResult(const std::string& path) {
   ROS_WARN("monitor: replacing the result of an earlier run in %s (%s)", path.c_str(), first.c_str());
 }
 
-bool appendToResult(const std::string& path, const std::string& lines) {
+bool replaceFileWith(const std::string& path, const std::string& text) {
+  const std::string partial = path + ".partial";
+  {
+    std::ofstream f(partial);
+    f << text;
+    if (!f) return false;
+  }
+  return std::rename(partial.c_str(), path.c_str()) == 0;
+}
+
+Appended appendToResult(const std::string& path, const std::string& lines) {
   std::ifstream in(path);
   std::stringstream text;
   text << in.rdbuf();
   const std::string body = text.str();
-  if (body.find("result: ") == std::string::npos || body.find("result: running") != std::string::npos) return false;
-  std::ofstream out(path, std::ios::app);
-  out << lines;
-  return static_cast<bool>(out);
+  if (body.find("result: ") == std::string::npos || body.find("result: running") != std::string::npos) return Appended::notYet;
+  if (replaceFileWith(path, body + lines)) return Appended::done;
+  ROS_ERROR("%s: cannot add to the result file %s", ros::this_node::getName().c_str(), path.c_str());
+  return Appended::failed;
 }
 
 void replaceEarlierBag(const std::string& path) {

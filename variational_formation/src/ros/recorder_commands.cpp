@@ -3,7 +3,7 @@
 // applies from, and the whole applied schedule into ~commands_file, a `simulate --commands` file.
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
+#include <sstream>
 
 #include "variational_formation_core/protocol/command_desk.hpp"
 #include "variational_formation/ros/output_files.hpp"
@@ -53,19 +53,9 @@ void RecorderNode::writeCommandsFile() const {
   for (const auto& m : commands_.commands) issued.emplace_back(m.step, commandOf(m));
   const CommandSchedule schedule = protocol::appliedSchedule(scenario_, issued);
   if (schedule.empty()) return;  // no manoeuvre and no command: nothing to replay
-  // Written beside and renamed over: a reader never sees half a file.
-  const std::string partial = commandsFile_ + ".partial";
-  {
-    std::ofstream f(partial);
-    writeCommands(f, schedule);
-    if (!f) {
-      ROS_ERROR("recorder: cannot write %s", partial.c_str());
-      return;
-    }
-  }
-  if (std::rename(partial.c_str(), commandsFile_.c_str()) != 0) {
-    ROS_ERROR("recorder: cannot write %s", commandsFile_.c_str());
-  }
+  std::ostringstream text;
+  writeCommands(text, schedule);
+  if (!replaceFileWith(commandsFile_, text.str())) ROS_ERROR("recorder: cannot write %s", commandsFile_.c_str());
 }
 
 }  // namespace vf

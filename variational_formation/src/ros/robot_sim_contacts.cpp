@@ -66,8 +66,9 @@ void RobotSimNode::checkContacts(const ros::Time& stamp) {
   }
   if (runOver_ && !resultWritten_) {
     // The monitor writes the file before it says the run is over; this robot adds its lines.
-    resultWritten_ = appendToResult(resultFile_, contacts_->log().resultLines());
-    if (resultWritten_) {
+    const Appended appended = appendToResult(resultFile_, contacts_->log().resultLines());
+    resultWritten_ = appended != Appended::notYet;  // a failure is said once, not every tick
+    if (appended == Appended::done) {
       ROS_INFO("%s: %ld contacts; closest body centres %.4f m (diameter %g m)", ros::this_node::getName().c_str(),
                contacts_->log().count(), contacts_->closest(), 2.0 * contacts_->bodyRadius());
     }

@@ -292,6 +292,13 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
                      f"output_dir:={out}"])
         try:
             self.assertTrue(watcher.wait_for(300), "the run did not start")
+            # This test's own subscriptions must have heard the monitor and every agent before
+            # the monitor stops: a stopped node cannot answer a new subscriber's connection.
+            end = time.time() + 60
+            while (allowed[0] == 0 or len(steps) < self.scenario["n"]) and time.time() < end:
+                time.sleep(0.05)
+            self.assertGreater(allowed[0], 0, "no progress heard from the monitor in 60 s")
+            self.assertEqual(len(steps), self.scenario["n"], f"states heard from agents {sorted(steps)} only")
             monitor = vf_rostest.node_pid("/formation/monitor")
             os.kill(monitor, signal.SIGSTOP)
             time.sleep(1.5)

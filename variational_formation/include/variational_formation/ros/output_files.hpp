@@ -28,11 +28,22 @@ void announceReplacedResult(const std::string& path);
 void replaceEarlierBag(const std::string& path);
 
 /**
- * Appends `lines` to the run's result file at `path` once the monitor has written its result
- * there (a world's or robot's lines, e.g. contacts). @return false if it has not yet, or on an
- * error writing.
+ * Writes `text` as the whole of the file at `path`: written beside it (`path`.partial) and
+ * renamed over it, so a reader sees the old file or the new one, never half of one.
+ * @return false on an error writing (nothing replaced).
  */
-bool appendToResult(const std::string& path, const std::string& lines);
+bool replaceFileWith(const std::string& path, const std::string& text);
+
+/// What appendToResult did.
+enum class Appended { notYet, done, failed };
+
+/**
+ * Appends `lines` to the run's result file at `path` once the monitor has written its result
+ * there (a world's or robot's lines, e.g. contacts), replacing the file whole (replaceFileWith).
+ * @return notYet while the file holds no result or "result: running", failed on an error
+ * writing (one ROS_ERROR line naming the file).
+ */
+Appended appendToResult(const std::string& path, const std::string& lines);
 
 /// Creates the directory that will hold `path` (like mkdir -p). @throws InvalidInput naming
 /// `parameter` when it cannot.
