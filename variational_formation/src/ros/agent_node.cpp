@@ -97,6 +97,8 @@ void AgentNode::carryOut(const Protocol::Ready& ready) {
   for (const AgentState::ConstPtr& state : ready.publish) publish(state);
   if (!ready.dropped.empty()) drop(ready.dropped);
   if (!ready.over.empty()) ROS_INFO("%s: %s", name_.c_str(), ready.over.c_str());
+  if (ready.resumedAt >= 0) ROS_INFO("%s: resumed at step %ld, the holders' newer state of mine", name_.c_str(), ready.resumedAt);
+  if (ready.recallAgain) recallAgain();
   if (ready.wakeWhenSensed) wakeWhenSensed();
   if (ready.wakeAfter > 0.0) paceFor(ready.wakeAfter);
 }

@@ -3,6 +3,13 @@
 // answers `~recall` (the newest state it holds of an agent) and `~history` (its own recent states
 // or a neighbour's) for others that restart.
 #include "variational_formation/ros/agent_node.hpp"
+
+#include <memory>
+#include <thread>
+
+#include <ros/callback_queue_interface.h>
+
+#include "variational_formation/ros/pacer.hpp"
 #include "variational_formation/ros/recalled.hpp"
 
 namespace vf {
@@ -27,6 +34,23 @@ void AgentNode::resume(const Recovery& r) {
   } catch (const std::exception& e) {
     ROS_WARN("%s: cannot resume from %s (%s): starting from the scenario", name_.c_str(), from.c_str(), e.what());
   }
+}
+
+void AgentNode::recallAgain() {
+  ROS_WARN("%s: a neighbour is two steps past my step %ld: it used a newer state of mine (my dead "
+           "incarnation's last, which reached it after I asked); asking the holders again",
+           name_.c_str(), agent().step());
+  // Not on the agent's queue: the holders may be served by this process's other threads.
+  const std::shared_ptr<bool> alive = alive_;
+  ros::CallbackQueueInterface* queue = nh_.getCallbackQueue();
+  std::thread([this, alive, queue, nh = nh_, id = agent().id(), holders = sources(), monitor = monitor_] {
+    const Recovery r = recallNewest(nh, id, holders, monitor);
+    queue->addCallback(boost::make_shared<QueuedCall>([this, alive, r] {
+      if (!*alive) return;
+      if (r.step > agent().step()) ROS_INFO("%s: %s holds my step %ld", name_.c_str(), r.from.c_str(), r.step);
+      carryOut(protocol_->step(Protocol::Recalled{r.step, r.found.position, r.found.previous_position}));
+    }), reinterpret_cast<uint64_t>(this));
+  }).detach();
 }
 
 bool AgentNode::onRecall(RecallState::Request& request, RecallState::Response& response) {

@@ -142,12 +142,13 @@ class World {
       }
     }
   }
-  /// Restarts agent i (asks its neighbours and the monitor where to resume).
-  void restartAgent(int i) {
+  /// Restarts agent i (asks its neighbours and the monitor where to resume). With
+  /// `deliverFirst`, what the dead incarnation did send arrives before the new one asks its
+  /// holders (a respawn usually takes far longer than a delivery); without, it stays in flight
+  /// (a loaded machine; ProtocolRun.LateStateOfTheDeadIncarnationMakesTheNewOneRecallAgain).
+  void restartAgent(int i, bool deliverFirst = true) {
     trace("restart agent " + std::to_string(i));
-    // What the dead incarnation did send arrives before the new one asks its holders (a respawn
-    // takes far longer than a delivery); see LateStateOfTheDeadIncarnation for the other order.
-    for (std::size_t k = 0; k < inFlight_.size();) {
+    for (std::size_t k = 0; deliverFirst && k < inFlight_.size();) {
       if (inFlight_[k].kind == Message::Kind::State && inFlight_[k].from == i) {
         deliver(k);
         k = 0;
@@ -189,6 +190,8 @@ class World {
   long writtenThrough() const { return recorder_.steps().handedOutThrough(); }
   long delivered() const { return delivered_; }
   long maxPendingSteps() const { return maxPending_; }
+  /// How often a restarted agent asked its holders again (Ready::recallAgain).
+  long recalledAgain() const { return recalledAgain_; }
   /// The newest step any live agent computed.
   long newestAgentStep() const {
     long newest = -1;
@@ -259,14 +262,20 @@ class World {
       m.to = Message::Recorder;
       send(m);
     }
+    if (ready.recallAgain) {  // the node asks from a thread of its own; here the holders answer at once
+      ++recalledAgain_;
+      trace("agent " + std::to_string(i) + " recalls again");
+      AgentProtocol::Recalled answer;
+      if (const std::optional<State> found = recall(i)) answer = {found->step, found->position, found->previous_position};
+      carryOut(i, agents_[static_cast<std::size_t>(i)]->step(answer));
+    }
   }
-  void startAgent(int i) {
-    auto a = std::make_unique<AgentProtocol>(LockstepAgent(scenario_, i), [](const LockstepAgent& c, const std::string&) {
-      return std::make_shared<const State>(State{c.id(), c.step(), c.position(), c.previousPosition()});
-    });
+  /// What restarting agent i's holders (its neighbours, then the monitor) answer to `~recall`:
+  /// the newest state of it they hold, chosen as the node chooses (protocol::chooseAgentResume).
+  std::optional<State> recall(int i) const {
     std::vector<protocol::RecallAnswer> answers;
     std::vector<State> found;
-    for (int j : a->agent().neighbourIds()) {
+    for (int j : agents_[static_cast<std::size_t>(i)]->agent().neighbourIds()) {
       protocol::RecallAnswer r;
       State s;
       r.answered = agents_[static_cast<std::size_t>(j)] != nullptr;
@@ -288,9 +297,17 @@ class World {
     answers.push_back(r);
     found.push_back(s);
     const int k = protocol::chooseAgentResume(answers);
-    if (k >= 0) a->resume(found[static_cast<std::size_t>(k)].step, found[static_cast<std::size_t>(k)].position,
-                          found[static_cast<std::size_t>(k)].previous_position);
+    if (k < 0) return std::nullopt;
+    return found[static_cast<std::size_t>(k)];
+  }
+  void startAgent(int i) {
+    auto a = std::make_unique<AgentProtocol>(LockstepAgent(scenario_, i), [](const LockstepAgent& c, const std::string&) {
+      return std::make_shared<const State>(State{c.id(), c.step(), c.position(), c.previousPosition()});
+    });
     agents_[static_cast<std::size_t>(i)] = std::move(a);
+    if (const std::optional<State> found = recall(i)) {
+      agents_[static_cast<std::size_t>(i)]->resume(found->step, found->position, found->previous_position);
+    }
     carryOut(i, agents_[static_cast<std::size_t>(i)]->start());
     // Latched topics: the new subscriber gets each neighbour's newest state and the progress.
     for (int j : agents_[static_cast<std::size_t>(i)]->agent().neighbourIds()) {
@@ -446,6 +463,7 @@ class World {
   std::vector<Positions> expected_;
   std::vector<std::unique_ptr<AgentProtocol>> agents_;
   std::map<int, State> latched_;  // each agent's newest published state
+  long recalledAgain_ = 0;
   std::optional<Progress> latchedProgress_;
   std::unique_ptr<Referee> monitor_;
   Recorder recorder_;

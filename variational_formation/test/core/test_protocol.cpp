@@ -7,6 +7,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <random>
 #include <sstream>
 
@@ -299,6 +300,50 @@ TEST(ProtocolRun, IncarnationKilledAgainBeforeTheMonitorGotItsStepComesFromItsNe
   w.restartAgent(1);
   ASSERT_TRUE(runInOrder(w)) << w.waitingFor();
   expectComplete(w, 20);
+}
+
+// A loaded machine (CI, hexagon3000 with 20 kills): the killed incarnation's last states reach
+// its neighbours only after the new one asked them where to resume. The new one resumes behind,
+// its neighbours run on with the dead one's states and come back two steps past it: from that it
+// knows a newer state of its own exists, asks again, resumes there and goes on exactly. Without
+// Ready::recallAgain the run stalls ("waiting for step k of agent_1").
+TEST(ProtocolRun, LateStateOfTheDeadIncarnationMakesTheNewOneRecallAgain) {
+  for (const long held : {6L, 11L}) {
+    World w(shortScenario("hexagon", 24), 6, 1);
+    std::mt19937 rng(2);
+    // Delivers the first message `pick` allows until there is none.
+    const auto deliverWhile = [&w](const std::function<bool(const Message&)>& pick) {
+      for (bool moved = true; moved;) {
+        moved = false;
+        for (std::size_t k = 0; k < w.inFlight().size() && !moved; ++k) {
+          if (pick(w.inFlight()[k])) {
+            w.deliver(k);
+            moved = true;
+          }
+        }
+      }
+    };
+    const auto late = [held](const Message& m) { return m.kind == Message::Kind::State && m.from == 1 && m.state.step >= held; };
+    deliverWhile([&late](const Message& m) { return !late(m); });  // agent 1's states from step `held` wait
+    ASSERT_GE(w.newestAgentStep(), held) << "agent 1 never published step " << held;
+    w.killAgent(1, rng, 0.0);                   // what it sent stays in flight
+    w.restartAgent(1, /*deliverFirst=*/false);  // its holders answer step held - 1
+    // Then the dead one's states arrive; the neighbours run on, and only then do the new one's
+    // subscriptions connect: it gets each neighbour's newest (latched) state.
+    deliverWhile([](const Message& m) { return m.to != 1; });
+    const auto toNewOne = [](const Message& m, int from) { return m.kind == Message::Kind::State && m.to == 1 && m.from == from; };
+    for (int j = 0; j < w.agentCount(); ++j) {
+      for (std::size_t k = 0; j != 1 && k < w.inFlight().size(); ++k) {
+        if (toNewOne(w.inFlight()[k], j)) {
+          w.reconnect(k);  // the connection's messages give way to the latched newest
+          break;
+        }
+      }
+    }
+    ASSERT_TRUE(runInOrder(w)) << w.waitingFor();
+    expectComplete(w, 24);
+    EXPECT_GE(w.recalledAgain(), 1) << "held from step " << held << ": the late states never put agent 1 behind";
+  }
 }
 
 TEST(ProtocolRun, MonitorRestartWithIncompleteStepsResumesExactly) {

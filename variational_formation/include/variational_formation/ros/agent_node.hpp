@@ -91,6 +91,9 @@ class AgentNode {
   void reportWaiting();
   void drop(const std::string& why);
   void resume(const Recovery& recovery);
+  /// Protocol's Ready::recallAgain: askHolders() from a thread of its own, the answer then
+  /// given to the protocol on this agent's queue (src/ros/agent_recovery.cpp).
+  void recallAgain();
   bool onRecall(RecallState::Request& request, RecallState::Response& response);
   bool onHistory(RecallHistory::Request& request, RecallHistory::Response& response);
   const LockstepAgent& agent() const { return protocol_->agent(); }

@@ -99,6 +99,8 @@ class LockstepAgent {
   double time() const { return static_cast<double>(step_) * coefficients_.timeStep; }
   /// scenario steps reached (never for steps = 0, unbounded).
   bool finished() const { return scenario_.steps > 0 && step_ >= scenario_.steps; }
+  /// advance() ran since the start or the last resume().
+  bool advancedSinceResume() const { return advanced_; }
   const std::vector<double>& position() const { return q_; }
   const std::vector<double>& previousPosition() const { return qPrev_; }
   const std::vector<int>& neighbourIds() const { return neighbourhood_.neighbourIds(); }

@@ -30,6 +30,10 @@ namespace vf::protocol {
  * - Failures: a step that is not finite is undone and its last good state published with the
  *   reason; so is a listed command it cannot apply. Either ends its stepping; the monitor ends
  *   the run.
+ * - Resumed behind: a neighbour's state two or more steps past a restarted agent's step, before
+ *   its first update, means that neighbour used a newer state of it (the dead incarnation's last,
+ *   which reached it after the holders were asked). It asks the holders again (Ready::recallAgain),
+ *   resumes from their answer (Recalled), and then takes the states it kept.
  *
  * StatePtr points to the caller's state message (fields id, step, position, previous_position);
  * it is built by `make` and kept as it is, so histories serve exactly what was published.
@@ -51,6 +55,9 @@ class AgentProtocol {
     std::string over;               ///< "" or: the run just ended (a line to log)
     bool wakeWhenSensed = false;    ///< waits for states: wake (Wake) when the shared board holds the step
     double wakeAfter = -1.0;        ///< >= 0: the pacing timer; wake (Wake) after this many seconds
+    /// Ask the holders again where to resume (as at a restart) and give their answer to step(Recalled).
+    bool recallAgain = false;
+    long resumedAt = -1;            ///< >= 0: it resumed at this step on a Recalled answer
   };
 
   /// A state on agent `topic`'s topic (already checked to come from its owner).
@@ -70,6 +77,11 @@ class AgentProtocol {
   };
   /// The pacing timer or the shared board says the agent may go on.
   struct Wake {};
+  /// The holders' answer after Ready::recallAgain: the newest state of this agent they hold.
+  struct Recalled {
+    long step = -1;  ///< -1: none beyond step 0
+    std::vector<double> position, previousPosition;
+  };
 
   /// @param realTimeFactor r (>= 0; 0: as fast as possible), validated by the caller.
   /// @param earliness how early a paced step may start [s] (>= 0): one due sooner goes now, so
@@ -97,22 +109,30 @@ class AgentProtocol {
 
   Ready step(const StateArrived& e) {
     Ready r;
-    try {
-      const auto& msg = *e.state;
-      const long sender = static_cast<long>(msg.id) == e.topic ? e.topic : -1;
-      const auto receipt = agent_.receive(sender, msg.step, msg.position, msg.previous_position);
-      if (receipt == LockstepAgent::Receipt::Accepted) {
-        const std::vector<int>& ids = agent_.neighbourIds();
-        const auto k = static_cast<std::size_t>(std::find(ids.begin(), ids.end(), e.topic) - ids.begin());
-        if (k < ids.size()) neighbourHistory_[k].push_back(e.state);
-        advance(r);
-      } else if (receipt != LockstepAgent::Receipt::Duplicate) {
-        r.dropped = "a state from agent_" + std::to_string(e.topic) + " (step " + std::to_string(msg.step) +
-                    "): " + LockstepAgent::describe(receipt);
-      }
-    } catch (const std::exception& ex) {
-      r.dropped = std::string("a state: ") + ex.what();
+    offer(r, e);
+    return r;
+  }
+
+  Ready step(const Recalled& e) {
+    Ready r;
+    recalling_ = false;
+    if (e.step <= agent_.step() || agent_.advancedSinceResume()) {
+      r.dropped = "the holders' newest state of this agent (step " + std::to_string(e.step) +
+                  ") is not past step " + std::to_string(agent_.step()) + "; waiting for a newer one";
+      return r;
     }
+    try {
+      agent_.resume(e.step, e.position, e.previousPosition);
+    } catch (const std::exception& ex) {
+      r.dropped = std::string("a recalled state: ") + ex.what();
+      return r;
+    }
+    r.resumedAt = e.step;
+    publishNow(r);  // the recovered state, as start() publishes it
+    std::vector<StateArrived> kept;
+    kept.swap(ahead_);
+    for (const StateArrived& s : kept) offer(r, s);
+    advance(r);
     return r;
   }
 
@@ -171,6 +191,14 @@ class AgentProtocol {
   /// What it waits for, in words. @param monitor the monitor's node name.
   std::string waitingFor(const std::string& monitor) const {
     if (!failure_.empty()) return "the monitor to end the run (" + failure_ + ")";
+    if (!ahead_.empty()) {
+      const StateArrived& newest = *std::max_element(ahead_.begin(), ahead_.end(), [](const StateArrived& a, const StateArrived& b) {
+        return a.state->step < b.state->step;
+      });
+      return "a newer state of its own: agent_" + std::to_string(newest.topic) + " is at step " +
+             std::to_string(newest.state->step) + ", past step " + std::to_string(agent_.step()) + " + 1" +
+             (recalling_ ? " (asking the holders again)" : " (the holders asked had none newer)");
+    }
     if (agent_.finished()) return "the monitor to end the run (last step " + std::to_string(agent_.step()) + " done)";
     if (agent_.step() >= allowedStep_) {
       return allowedStep_ == 0 ? "the monitor " + monitor + " to start the run (it waits for every participant)"
@@ -214,6 +242,44 @@ class AgentProtocol {
   long commandsHeld() const { return commandsHeld_; }
 
  private:
+  void offer(Ready& r, const StateArrived& e) {
+    try {
+      const auto& msg = *e.state;
+      const long sender = static_cast<long>(msg.id) == e.topic ? e.topic : -1;
+      const auto receipt = agent_.receive(sender, msg.step, msg.position, msg.previous_position);
+      if (receipt == LockstepAgent::Receipt::Accepted) {
+        const std::vector<int>& ids = agent_.neighbourIds();
+        const auto k = static_cast<std::size_t>(std::find(ids.begin(), ids.end(), e.topic) - ids.begin());
+        if (k < ids.size()) neighbourHistory_[k].push_back(e.state);
+        advance(r);
+      } else if (receipt == LockstepAgent::Receipt::ImpossibleStep && sender >= 0 && msg.step > agent_.step() + 1 &&
+                 !agent_.advancedSinceResume()) {
+        keepAhead(r, e);
+      } else if (receipt != LockstepAgent::Receipt::Duplicate) {
+        r.dropped = "a state from agent_" + std::to_string(e.topic) + " (step " + std::to_string(msg.step) +
+                    "): " + LockstepAgent::describe(receipt);
+      }
+    } catch (const std::exception& ex) {
+      r.dropped = std::string("a state: ") + ex.what();
+    }
+  }
+  /// A state two or more steps past ours before our first update: its sender computed from a
+  /// newer state of ours than the one we resumed from. Kept (the newest per sender) until the
+  /// holders answer again; asked once per newer such step, so an answer that is no newer waits
+  /// for the next one instead of asking in a loop.
+  void keepAhead(Ready& r, const StateArrived& e) {
+    const auto same = std::find_if(ahead_.begin(), ahead_.end(), [&e](const StateArrived& k) { return k.topic == e.topic; });
+    if (same == ahead_.end()) {
+      ahead_.push_back(e);
+    } else if (same->state->step < e.state->step) {
+      *same = e;
+    }
+    if (!recalling_ && e.state->step > askedAt_) {
+      recalling_ = true;
+      askedAt_ = e.state->step;
+      r.recallAgain = true;
+    }
+  }
   /// Computes every step the gates allow (the flow gate is this loop's condition).
   void advance(Ready& r) {
     while (exitStatus_ < 0 && failure_.empty() && !agent_.finished() && agent_.step() < allowedStep_ &&
@@ -287,6 +353,9 @@ class AgentProtocol {
   long startStep_ = 0;
   int exitStatus_ = -1;
   std::string failure_;
+  std::vector<StateArrived> ahead_;  // states past our step + 1, kept while the holders are asked again
+  bool recalling_ = false;           // Ready::recallAgain said, no Recalled yet
+  long askedAt_ = -1;                // the newest kept step that made it ask
 };
 
 }  // namespace vf::protocol
