@@ -67,7 +67,9 @@ if(CATKIN_ENABLE_TESTING)
     "fault:=stop_agent seed:=4" "fault:=kill_monitor seed:=6" "fault:=kill_recorder seed:=7"
     # 20 kills of one agent, unpaced: a state of a dead incarnation may be held only by its
     # neighbours (doc/distributed.md, recovery).
-    "fault:=kill_agent kills:=20 seed:=17 rate:=0 test_scenario:=hexagon3000")
+    "fault:=kill_agent kills:=20 seed:=17 rate:=0 test_scenario:=hexagon3000"
+    # An agent killed while its recall holders are stopped: it must ask them again (doc/distributed.md, recovery).
+    "fault:=kill_holders_stopped seed:=8")
   # Time-driven agents (test/ros/timed_run.test), hexagon at rate 1.
   vf_add_rostest_cases(test/ros/timed_run.test
     "case:=no_faults" "case:=faults delay:=0.05 jitter:=0.02 loss:=0.2"

@@ -37,9 +37,8 @@ void AgentNode::resume(const Recovery& r) {
 }
 
 void AgentNode::recallAgain() {
-  ROS_WARN("%s: a neighbour is two steps past my step %ld: it used a newer state of mine (my dead "
-           "incarnation's last, which reached it after I asked); asking the holders again",
-           name_.c_str(), agent().step());
+  ROS_WARN("%s: a neighbour is two steps past my step %ld, so it holds a newer state of mine than "
+           "the one I resumed from; asking the holders again", name_.c_str(), agent().step());
   // Not on the agent's queue: the holders may be served by this process's other threads.
   const std::shared_ptr<bool> alive = alive_;
   ros::CallbackQueueInterface* queue = nh_.getCallbackQueue();

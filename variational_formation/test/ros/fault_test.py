@@ -10,6 +10,11 @@ Faults (~fault), at a step drawn from ~seed (reported in the output):
                     histories and goes on; every step's status is right, Noether included
   kill_recorder     SIGKILL to the recorder: the run fails naming it, and the bag it leaves is
                     readable after `rosbag reindex`, with every step recorded so far intact
+  kill_holders_stopped
+                    SIGSTOP to an agent's neighbours and the monitor (its recall holders), then
+                    SIGKILL to the agent: the respawned one gets no answer, starts from the
+                    scenario, and on SIGCONT sees its neighbours far past step 0. It must ask its
+                    holders again and resume from them (doc/distributed.md, "Crash recovery")
 For agent faults it also prints the recovery time: from the kill until the respawned agent
 publishes a step it had not published before.
 """
@@ -50,6 +55,7 @@ class Watch:
         self.lock = threading.Lock()
         self.step = -1
         self.newest = {i: (-1, 0.0) for i in range(n)}
+        self.last = {i: -1 for i in range(n)}  # the step of each agent's last state, older or not
         self.subs = [rospy.Subscriber(f"{NS}/status", FormationStatus, self.on_status, queue_size=10000)]
         self.subs += [rospy.Subscriber(f"{NS}/agent_{i}/state", AgentState, self.on_state, i, queue_size=10000)
                       for i in range(n)]
@@ -62,6 +68,7 @@ class Watch:
         if msg._connection_header.get("callerid") != f"{NS}/agent_{i}":
             return
         with self.lock:
+            self.last[i] = msg.step
             if msg.step > self.newest[i][0]:
                 self.newest[i] = (msg.step, time.monotonic())
 
@@ -115,6 +122,8 @@ class FaultRun(unittest.TestCase, vf_rostest.RunChecks):
             cls.inject(rng.randrange(20, steps - 40), ["monitor"], signal.SIGKILL)
         elif cls.fault == "kill_recorder":
             cls.inject(rng.randrange(20, steps - 40), ["recorder"], signal.SIGKILL)
+        elif cls.fault == "kill_holders_stopped":
+            cls.kill_with_holders_stopped(rng.randrange(20, steps // 2), rng.randrange(n))
         else:
             raise AssertionError(f"unknown ~fault {cls.fault}")
         cls.result = vf_rostest.wait_for_result(os.path.join(cls.out, cls.name + ".result.yaml"), 120.0)
@@ -147,6 +156,31 @@ class FaultRun(unittest.TestCase, vf_rostest.RunChecks):
             # The respawned monitor goes on: wait until it completes steps again.
             assert cls.watch.wait_for_step(step + 30), "no status after the monitor was killed"
             cls.monitor_pids = (pids[0], vf_rostest.node_pid(f"{NS}/monitor"))
+
+    @classmethod
+    def kill_with_holders_stopped(cls, step, victim):
+        assert cls.watch.wait_for_step(step), f"the run never reached step {step}"
+        holders = [f"{NS}/agent_{j}" for j in cls.scenario["neighbours"][victim]] + [f"{NS}/monitor"]
+        stopped = [vf_rostest.node_pid(h) for h in holders]
+        for pid in stopped:
+            os.kill(pid, signal.SIGSTOP)
+        time.sleep(0.5)  # what the victim still publishes reaches only stopped receivers
+        before = cls.watch.newest[victim][0]
+        os.kill(vf_rostest.node_pid(f"{NS}/agent_{victim}"), signal.SIGKILL)
+        rospy.loginfo("fault_test: seed %d: SIGSTOP to %s, then SIGKILL to agent_%d at its step %d", cls.seed,
+                      ", ".join(holders), victim, before)
+        cls.injected.append((step, [f"{NS}/agent_{victim}"]))
+        # The respawned agent's recall gets no answer within its 2 s: it starts from the scenario.
+        end = time.time() + 30
+        while cls.watch.last[victim] != 0 and time.time() < end:
+            time.sleep(0.01)
+        started = cls.watch.last[victim] == 0
+        for pid in stopped:
+            os.kill(pid, signal.SIGCONT)
+        assert started, f"the respawned agent_{victim} never published step 0 (its last state: {cls.watch.last[victim]})"
+        seconds = cls.watch.wait_for_agent_beyond(victim, before)
+        assert seconds is not None, (f"agent_{victim}, started from the scenario, never went past its old step "
+                                     f"{before} (the newest complete step seen is {cls.watch.step})")
 
     @classmethod
     def tearDownClass(cls):
