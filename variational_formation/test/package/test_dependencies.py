@@ -70,53 +70,53 @@ class DependenciesTest(unittest.TestCase):
     def test_cpp_includes(self):
         standard = set()
         for _ in self.each_package():
-          for path in self.files("include/**/*.hpp", "src/**/*.cpp", "test/**/*.cpp", "test/**/*.hpp", "benchmark/*.cpp"):
-            relative = self.relative(path)
-            tags = TEST + BUILD if os.path.relpath(path, self.root).startswith(("test/", "benchmark/")) else BUILD
-            with open(path) as f:
-                for folder in re.findall(r'^\s*#\s*include\s*<([^>/]+)/', f.read(), re.M):
-                    if folder in SYSTEM_INCLUDES:
-                        continue
-                    self.need(INCLUDE_KEYS.get(folder, folder), tags, relative)
-                standard.add(relative)
+            for path in self.files("include/**/*.hpp", "src/**/*.cpp", "test/**/*.cpp", "test/**/*.hpp", "benchmark/*.cpp"):
+                relative = self.relative(path)
+                tags = TEST + BUILD if os.path.relpath(path, self.root).startswith(("test/", "benchmark/")) else BUILD
+                with open(path) as f:
+                    for folder in re.findall(r'^\s*#\s*include\s*<([^>/]+)/', f.read(), re.M):
+                        if folder in SYSTEM_INCLUDES:
+                            continue
+                        self.need(INCLUDE_KEYS.get(folder, folder), tags, relative)
+                    standard.add(relative)
         self.assertGreater(len(standard), 50)
 
     def test_python_imports(self):
         for _ in self.each_package():
-          local = {os.path.splitext(os.path.basename(p))[0] for p in self.files("scripts/*.py", "test/**/*.py")}
-          for path in self.files("scripts/*.py", "src/variational_formation/*.py", "test/**/*.py"):
-            relative = self.relative(path)
-            tags = TEST + EXEC if os.path.relpath(path, self.root).startswith("test/") else EXEC
-            with open(path) as f:
-                for module in re.findall(r'^\s*(?:import|from)\s+([A-Za-z_][A-Za-z_0-9]*)', f.read(), re.M):
-                    if module in sys.stdlib_module_names or module in local:
-                        continue
-                    self.need(PYTHON_KEYS.get(module, module), tags, relative)
+            local = {os.path.splitext(os.path.basename(p))[0] for p in self.files("scripts/*.py", "test/**/*.py")}
+            for path in self.files("scripts/*.py", "src/variational_formation/*.py", "test/**/*.py"):
+                relative = self.relative(path)
+                tags = TEST + EXEC if os.path.relpath(path, self.root).startswith("test/") else EXEC
+                with open(path) as f:
+                    for module in re.findall(r'^\s*(?:import|from)\s+([A-Za-z_][A-Za-z_0-9]*)', f.read(), re.M):
+                        if module in sys.stdlib_module_names or module in local:
+                            continue
+                        self.need(PYTHON_KEYS.get(module, module), tags, relative)
 
     def test_find_package(self):
         for _ in self.each_package():
-          for path in self.files("CMakeLists.txt", "cmake/*.cmake"):
-            with open(path) as f:
-                text = f.read()
-            relative = self.relative(path)
-            for name, rest in re.findall(r'find_package\(\s*([^\s)]+)([^)]*)\)', text):
-                tags = TEST + BUILD if name == "rostest" else BUILD
-                self.need(FIND_PACKAGE_KEYS.get(name, name), tags, relative)
-                if "COMPONENTS" in rest:
-                    for component in rest.split("COMPONENTS", 1)[1].split():
-                        self.need(component, BUILD, relative)
+            for path in self.files("CMakeLists.txt", "cmake/*.cmake"):
+                with open(path) as f:
+                    text = f.read()
+                relative = self.relative(path)
+                for name, rest in re.findall(r'find_package\(\s*([^\s)]+)([^)]*)\)', text):
+                    tags = TEST + BUILD if name == "rostest" else BUILD
+                    self.need(FIND_PACKAGE_KEYS.get(name, name), tags, relative)
+                    if "COMPONENTS" in rest:
+                        for component in rest.split("COMPONENTS", 1)[1].split():
+                            self.need(component, BUILD, relative)
 
     def test_launch_packages(self):
         for _ in self.each_package():
-          for path in self.files("launch/**/*.launch", "test/**/*.test", "test/**/*.launch"):
-            relative = self.relative(path)
-            tags = TEST + EXEC if os.path.relpath(path, self.root).startswith("test/") else EXEC
-            with open(path) as f:
-                text = f.read()
-            for value in re.findall(r'\bpkg="([^"]+)"', text):
-                # pkg="$(eval 'a' if x else 'b')": every quoted name.
-                for key in re.findall(r"'([A-Za-z_0-9]+)'", value) if value.startswith("$(") else [value]:
-                    self.need(key, tags, relative)
+            for path in self.files("launch/**/*.launch", "test/**/*.test", "test/**/*.launch"):
+                relative = self.relative(path)
+                tags = TEST + EXEC if os.path.relpath(path, self.root).startswith("test/") else EXEC
+                with open(path) as f:
+                    text = f.read()
+                for value in re.findall(r'\bpkg="([^"]+)"', text):
+                    # pkg="$(eval 'a' if x else 'b')": every quoted name.
+                    for key in re.findall(r"'([A-Za-z_0-9]+)'", value) if value.startswith("$(") else [value]:
+                        self.need(key, tags, relative)
 
     def test_every_key_maps_to_debian_packages(self):
         mapping = {}
