@@ -14,6 +14,8 @@ target_sources(variational_formation_ros PRIVATE src/ros/lockstep_monitor.cpp sr
   src/ros/monitor_shape.cpp src/ros/monitor_robots.cpp src/ros/monitor_goals.cpp src/ros/goal_server.cpp src/ros/monitor_safety.cpp
   src/ros/recorder_bag.cpp src/ros/recorder_commands.cpp
   src/ros/sensing_hub.cpp src/ros/service_call.cpp src/ros/state_batch.cpp src/ros/periodic_call.cpp src/ros/pacer.cpp src/ros/trails.cpp)
+# An agent manager's own agents hand their states to each other in the process (doc/distributed.md).
+target_sources(variational_formation_ros PRIVATE src/ros/local_states.cpp)
 add_dependencies(variational_formation_ros ${PROJECT_NAME}_gencfg)
 # catkin's include path is given to each ROS target privately (never exported: catkin_lint).
 target_include_directories(variational_formation_ros SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
@@ -116,6 +118,8 @@ if(CATKIN_ENABLE_TESTING)
   add_rostest(test/ros/render.test ARGS kind:=robots)
   # The same with world:=mujoco: the world's markers (bodies, headings, contacts) in the bag and video.
   add_rostest(test/ros/render.test ARGS kind:=mujoco)
+  # Local delivery in two agent_managers: subscribers outside get every state, a late one the newest.
+  add_rostest(test/ros/local_delivery.test)
   # SIGKILL to the nodelet manager of every agent during a recorded run: test/ros/nodelet_fault.test.
   add_rostest(test/ros/nodelet_fault.test ARGS seed:=3)
   # Lockstep with the safety filter on (test/ros/safety_run.test, doc/distributed.md "Sensing"):
@@ -152,5 +156,5 @@ install(TARGETS robot_sim RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 add_executable(benchmark_transport benchmark/benchmark_transport.cpp)
 add_dependencies(benchmark_transport ${PROJECT_NAME}_generate_messages_cpp)
 target_include_directories(benchmark_transport SYSTEM PRIVATE ${catkin_INCLUDE_DIRS})
-target_link_libraries(benchmark_transport ${catkin_LIBRARIES})
+target_link_libraries(benchmark_transport variational_formation_core ${catkin_LIBRARIES})
 target_compile_options(benchmark_transport PRIVATE ${VF_FLAGS})

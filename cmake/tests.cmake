@@ -7,6 +7,8 @@ if(CATKIN_ENABLE_TESTING)
   foreach(name ${VF_CORE_TESTS} command_desk)
     vf_add_gtest(test_${name} test/core/test_${name}.cpp variational_formation_core)
   endforeach()
+  # The agents of one process handing states to each other (doc/distributed.md, "Local delivery").
+  vf_add_gtest(test_local_delivery test/core/test_local_delivery.cpp variational_formation_core)
   # The layer guard reads what the built core library links (test_layers.cpp).
   target_compile_definitions(test_layers PRIVATE VF_CORE_LIBRARY="$<TARGET_FILE:variational_formation_core>")
   # The protocol's event sequences and seeded interleavings, over shipped and generated formations
