@@ -41,6 +41,7 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   worldFrame_ = worldFrame(pnh);
   exchange_ = LocalStates::of(nh);
   if (exchange_ && !exchange_->hosts(id)) exchange_ = nullptr;
+  if (exchange_) LocalStates::place(id, nh.getCallbackQueue());
   advertiseState(nh);
   for (int j = 0; j < scenario.agentCount(); ++j) owners_.push_back(agentNodeName(nh, j));
   // Served from the start, so that restarting neighbours can ask; the subscriptions wait for
@@ -197,12 +198,35 @@ void AgentNode::listenLocally() {
   const std::shared_ptr<bool> alive = alive_;
   for (int j : sources()) {
     if (!exchange_->hosts(j)) continue;
+    // A neighbour on this agent's thread: into the inbox, read right after the callback that
+    // published it (depth first: the state is still in the cache). One on another thread: a
+    // call on this agent's queue. Either way per neighbour, so its states stay in order.
+    // (The neighbour's queue is placed before it publishes anything that reaches this handler.)
     exchange_->listen(j, reinterpret_cast<std::uintptr_t>(this),
                       [this, queue, alive](int source, const AgentState::ConstPtr& state) {
+                        if (LocalStates::queueOf(source) == queue && AgentThreads::serves(queue)) {
+                          inbox_.emplace_back(source, state);
+                          if (!inboxRead_) {
+                            inboxRead_ = true;
+                            AgentThreads::soon([this, alive] {
+                              if (*alive) readInbox();
+                            });
+                          }
+                          return;
+                        }
                         queueCall(queue, [this, alive, source, state] {
                           if (*alive) carryOut(protocol_->step(Protocol::StateArrived{source, state}));
                         }, reinterpret_cast<uint64_t>(this));
                       });
+  }
+}
+
+void AgentNode::readInbox() {
+  inboxRead_ = false;
+  while (!inbox_.empty()) {
+    const std::pair<int, AgentState::ConstPtr> arrived = std::move(inbox_.front());
+    inbox_.pop_front();
+    carryOut(protocol_->step(Protocol::StateArrived{arrived.first, arrived.second}));
   }
 }
 

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
@@ -83,6 +84,8 @@ class AgentNode {
   void onNeighbourState(int neighbour, const ros::MessageEvent<AgentState const>& event);
   /// Takes the neighbours' states that the manager's exchange holds from it (on this agent's queue).
   void listenLocally();
+  /// The states in inbox_, oldest first.
+  void readInbox();
   /// Advertises the state topic: latched, or with the exchange, gated by the audience.
   void advertiseState(ros::NodeHandle& nh);
   /// With a shared board: a Wake on this agent's queue once the board holds step k.
@@ -111,6 +114,9 @@ class AgentNode {
   ros::Publisher statePub_;
   LocalStates::Exchange* exchange_ = nullptr;  // the manager's, if it hosts this agent
   std::unique_ptr<TopicAudience<AgentState::ConstPtr>> audience_;  // with exchange_: who else needs the topic
+  // States of neighbours on this agent's thread, handed over by the exchange (AgentThreads::soon).
+  std::deque<std::pair<int, AgentState::ConstPtr>> inbox_;
+  bool inboxRead_ = false;  // a readInbox is due on the thread's lane
   std::vector<ros::Subscriber> subs_;
   std::vector<std::string> owners_;           // full node names, by agent id
   std::vector<std::string> managers_;         // ~agent_manager: nodelet managers of agents

@@ -25,6 +25,10 @@ class LocalStates {
   static void stop();
   /// The exchange of the agents in the namespace of `nh`; nullptr if this process has none for it.
   static Exchange* of(const ros::NodeHandle& nh);
+  /// Hosted agent `id` runs its callbacks on `queue` (set when it is constructed).
+  static void place(int id, ros::CallbackQueueInterface* queue);
+  /// The queue of hosted agent `id`; nullptr if not placed (yet) or not hosted.
+  static ros::CallbackQueueInterface* queueOf(int id);
 };
 
 }  // namespace vf
