@@ -43,7 +43,10 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   const std::string ns = framePrefix(nh);
   frame_ = ns + name_;
   worldFrame_ = worldFrame(pnh);
-  statePub_ = nh.advertise<AgentState>(name_ + "/state", 1000, /*latch=*/true);
+  exchange_ = LocalStates::of(nh);
+  if (exchange_ && !exchange_->hosts(id)) exchange_ = nullptr;
+  if (exchange_) LocalStates::place(id, nh.getCallbackQueue());
+  advertiseState(nh);
   for (int j = 0; j < scenario.agentCount(); ++j) owners_.push_back(agentNodeName(nh, j));
   // Served from the start, so that restarting neighbours can ask; the subscriptions wait for
   // start(), which resumes the agent before any state reaches it.
@@ -61,7 +64,29 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   }
 }
 
+void AgentNode::advertiseState(ros::NodeHandle& nh) {
+  if (!exchange_) {
+    statePub_ = nh.advertise<AgentState>(name_ + "/state", 1000, /*latch=*/true);
+    return;
+  }
+  audience_ = std::make_unique<TopicAudience<AgentState::ConstPtr>>(ros::this_node::getName());
+  // Connections are reported on this agent's queue, where it publishes: no lock is needed.
+  const std::shared_ptr<bool> alive = alive_;
+  ros::AdvertiseOptions options = ros::AdvertiseOptions::create<AgentState>(
+      name_ + "/state", 1000,
+      [this, alive](const ros::SingleSubscriberPublisher& s) {
+        if (!*alive) return;
+        if (const AgentState::ConstPtr newest = audience_->connected(s.getSubscriberName())) s.publish(*newest);
+      },
+      [this, alive](const ros::SingleSubscriberPublisher& s) {
+        if (*alive) audience_->disconnected(s.getSubscriberName());
+      },
+      ros::VoidConstPtr(), nullptr);
+  statePub_ = nh.advertise(options);
+}
+
 AgentNode::~AgentNode() {
+  if (exchange_) exchange_->stopListening(reinterpret_cast<std::uintptr_t>(this));
   *alive_ = false;
   Pacer::instance().cancel(reinterpret_cast<uint64_t>(this));
 }
@@ -114,6 +139,8 @@ void AgentNode::paceFor(double wait) {
 }
 
 void AgentNode::onNeighbourState(int neighbour, const ros::MessageEvent<AgentState const>& event) {
+  // From this process, a local neighbour's state reached the agent through the exchange already.
+  if (exchange_ && exchange_->hosts(neighbour) && event.getPublisherName() == ros::this_node::getName()) return;
   if (!fromAgent(event, owners_[static_cast<std::size_t>(neighbour)], managers_)) {
     drop("a state on agent_" + std::to_string(neighbour) + "'s topic from " + event.getPublisherName() +
          ", which does not own it");
@@ -150,7 +177,12 @@ AgentState::ConstPtr AgentNode::makeState(const LockstepAgent& a, const std::str
 }
 
 void AgentNode::publish(const AgentState::ConstPtr& state) {
-  statePub_.publish(state);
+  if (!exchange_) {
+    statePub_.publish(state);
+  } else {
+    exchange_->deliver(agent().id(), state);
+    if (audience_->published(state)) statePub_.publish(state);
+  }
   if (StateBatch* batch = StateBatch::local()) batch->add(state);  // in an agent_manager
   tf_.sendTransform(frameAt(state->header, frame_, state->position));
 }
@@ -164,12 +196,51 @@ void AgentNode::reportWaiting() {
   lastReportAt_ = ros::WallTime::now();
 }
 
+void AgentNode::listenLocally() {
+  if (!exchange_) return;
+  ros::CallbackQueueInterface* queue = nh_.getCallbackQueue();
+  const std::shared_ptr<bool> alive = alive_;
+  for (int j : sources()) {
+    if (!exchange_->hosts(j)) continue;
+    // A neighbour on this agent's thread: into the inbox, read right after the callback that
+    // published it (depth first: the state is still in the cache). One on another thread: a
+    // call on this agent's queue. Either way per neighbour, so its states stay in order.
+    // (The neighbour's queue is placed before it publishes anything that reaches this handler.)
+    exchange_->listen(j, reinterpret_cast<std::uintptr_t>(this),
+                      [this, queue, alive](int source, const AgentState::ConstPtr& state) {
+                        if (LocalStates::queueOf(source) == queue && AgentThreads::serves(queue)) {
+                          inbox_.emplace_back(source, state);
+                          if (!inboxRead_) {
+                            inboxRead_ = true;
+                            AgentThreads::soon([this, alive] {
+                              if (*alive) readInbox();
+                            });
+                          }
+                          return;
+                        }
+                        queueCall(queue, [this, alive, source, state] {
+                          if (*alive) carryOut(protocol_->step(Protocol::StateArrived{source, state}));
+                        }, reinterpret_cast<uint64_t>(this));
+                      });
+  }
+}
+
+void AgentNode::readInbox() {
+  inboxRead_ = false;
+  while (!inbox_.empty()) {
+    const std::pair<int, AgentState::ConstPtr> arrived = std::move(inbox_.front());
+    inbox_.pop_front();
+    carryOut(protocol_->step(Protocol::StateArrived{arrived.first, arrived.second}));
+  }
+}
+
 void AgentNode::start(const Recovery& recovery) {
   resume(recovery);
   subscribeToFormation(
       nh_, sources(), 1000,
       [this](int j, const ros::MessageEvent<AgentState const>& e) { onNeighbourState(j, e); },
       [this](const ros::MessageEvent<RunProgress const>& e) { onProgress(e); }, subs_, progressSub_);
+  listenLocally();
   commandSub_ = nh_.subscribe<variational_formation_msgs::FormationCommands>(
       "command", 10,
       boost::function<void(const ros::MessageEvent<variational_formation_msgs::FormationCommands const>&)>(

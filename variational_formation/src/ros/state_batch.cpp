@@ -91,7 +91,14 @@ void StateBatch::onConnect(const ros::SingleSubscriberPublisher& subscriber) {
 
 namespace {
 std::unique_ptr<AgentThreads> gThreads;  // this process's, if it is an agent manager
+constexpr int kLaneBurst = 64;           // soon() calls run between two looks at the queue
+thread_local const ros::CallbackQueueInterface* tServed = nullptr;  // the queue this thread serves
+thread_local std::vector<std::function<void()>> tLane;               // soon(): newest last
 }  // namespace
+
+bool AgentThreads::serves(const ros::CallbackQueueInterface* queue) { return queue != nullptr && tServed == queue; }
+
+void AgentThreads::soon(std::function<void()> work) { tLane.push_back(std::move(work)); }
 
 void AgentThreads::start(int threads) { gThreads.reset(new AgentThreads(threads)); }
 
@@ -103,7 +110,17 @@ AgentThreads::AgentThreads(int threads) {
   for (int k = 0; k < std::max(1, threads); ++k) queues_.push_back(std::make_unique<ros::CallbackQueue>());
   for (auto& q : queues_) {
     threads_.emplace_back([this, queue = q.get()] {
-      while (!stopping_) queue->callAvailable(ros::WallDuration(0.1));
+      tServed = queue;
+      while (!stopping_) {
+        // With work of its own waiting, only a look at the queue; else wait for a callback.
+        queue->callAvailable(tLane.empty() ? ros::WallDuration(0.1) : ros::WallDuration());
+        for (int k = 0; k < kLaneBurst && !tLane.empty() && !stopping_; ++k) {
+          const std::function<void()> work = std::move(tLane.back());
+          tLane.pop_back();
+          work();
+        }
+      }
+      tLane.clear();
     });
   }
 }

@@ -2,6 +2,7 @@
 
 #include <condition_variable>
 #include <atomic>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -83,6 +84,15 @@ class AgentThreads {
   static AgentThreads* local();
   /// The queue of the next agent loaded.
   ros::CallbackQueue* nextQueue();
+  /// Whether the calling thread is the one that serves `queue`.
+  static bool serves(const ros::CallbackQueueInterface* queue);
+  /**
+   * Runs `work` on the calling thread (one of these threads) after the callback that adds it, the
+   * newest added first, ahead of the queue's later callbacks but interleaved with them (64 at a
+   * time): a state handed from one agent to a neighbour on the same thread is read while it is
+   * still in the cache (doc/distributed.md, "Local delivery"). Only from one of these threads.
+   */
+  static void soon(std::function<void()> work);
   ~AgentThreads();
 
  private:
