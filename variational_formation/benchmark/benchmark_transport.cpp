@@ -10,8 +10,8 @@
 //
 // --delivery local (the default) hands the states between the agents of the process as an
 // agent_manager does (doc/distributed.md, "Local delivery"): through a LocalExchange, one queued
-// call per state and listener, each agent's topic published only while a subscriber in another
-// process is connected (TopicAudience), so the in-process collector of `--collector topics`
+// call per state and listener, each agent's topic silent until a subscriber in another
+// process connects (TopicAudience), so the in-process collector of `--collector topics`
 // listens to the exchange too. --delivery roscpp publishes every state on its topic, as before:
 // roscpp's publish finds the topic by a linear search through all of the process's publications,
 // so its cost per agent-step grows with the agents (doc/benchmarks.md).
@@ -189,8 +189,8 @@ int main(int argc, char** argv) {
         [audience](const ros::SingleSubscriberPublisher& s) {
           if (const AgentState::ConstPtr newest = audience->connected(s.getSubscriberName())) s.publish(*newest);
         },
-        [audience](const ros::SingleSubscriberPublisher& s) { audience->disconnected(s.getSubscriberName()); },
-        ros::VoidConstPtr(), nullptr);
+        ros::SubscriberStatusCallback(), ros::VoidConstPtr(), nullptr);
+    options.latch = true;  // as an agent_manager's agents (TopicAudience)
     a.pub = nh.advertise(options);
   }
   if (b.batch) b.batchPub = nh.advertise<AgentStates>("states", 1000);

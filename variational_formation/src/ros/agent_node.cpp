@@ -29,13 +29,15 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   const std::string path = requiredParam<std::string>(pnh, "scenario");
   realTimeFactor_ = optionalParam(pnh, "real_time_factor", 0.0);
   monitor_ = participantName(nh, optionalParam<std::string>(pnh, "monitor", "monitor"));
-  const Scenario scenario = sharedScenario(path);
+  // One scenario and formation for all the agents of the process, not a copy each.
+  const std::shared_ptr<const Scenario> shared = sharedScenarioObject(path);
+  const Scenario& scenario = *shared;
   validateRealTimeFactor(realTimeFactor_, scenario.timeStep, "~real_time_factor");
   managers_ = agentManagers(nh, pnh);
   const std::shared_ptr<SensingBoard> board = SensingHub::board(nh, scenario, managers_);
   sharedBoard_ = board != nullptr;
   protocol_ = std::make_unique<Protocol>(
-      LockstepAgent(scenario, id, StartMethod::Variational, board),
+      LockstepAgent(shared, sharedFormation(shared), id, StartMethod::Variational, board),
       [this](const LockstepAgent& a, const std::string& failure) { return makeState(a, failure); }, realTimeFactor_,
       [] { return ros::WallTime::now().toSec(); }, Pacer::kGrain);
   name_ = "agent_" + std::to_string(id);
@@ -47,7 +49,7 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   if (exchange_ && !exchange_->hosts(id)) exchange_ = nullptr;
   if (exchange_) LocalStates::place(id, nh.getCallbackQueue());
   advertiseState(nh);
-  for (int j = 0; j < scenario.agentCount(); ++j) owners_.push_back(agentNodeName(nh, j));
+  for (int j : sources()) owners_[j] = agentNodeName(nh, j);  // only whose topics it reads
   // Served from the start, so that restarting neighbours can ask; the subscriptions wait for
   // start(), which resumes the agent before any state reaches it.
   recallServer_ = nh.advertiseService(name_ + "/recall", &AgentNode::onRecall, this);
@@ -78,10 +80,8 @@ void AgentNode::advertiseState(ros::NodeHandle& nh) {
         if (!*alive) return;
         if (const AgentState::ConstPtr newest = audience_->connected(s.getSubscriberName())) s.publish(*newest);
       },
-      [this, alive](const ros::SingleSubscriberPublisher& s) {
-        if (*alive) audience_->disconnected(s.getSubscriberName());
-      },
-      ros::VoidConstPtr(), nullptr);
+      ros::SubscriberStatusCallback(), ros::VoidConstPtr(), nullptr);
+  options.latch = true;  // once live (TopicAudience): the latch hands a new subscriber the newest
   statePub_ = nh.advertise(options);
 }
 
@@ -141,7 +141,7 @@ void AgentNode::paceFor(double wait) {
 void AgentNode::onNeighbourState(int neighbour, const ros::MessageEvent<AgentState const>& event) {
   // From this process, a local neighbour's state reached the agent through the exchange already.
   if (exchange_ && exchange_->hosts(neighbour) && event.getPublisherName() == ros::this_node::getName()) return;
-  if (!fromAgent(event, owners_[static_cast<std::size_t>(neighbour)], managers_)) {
+  if (!fromAgent(event, owners_.at(neighbour), managers_)) {
     drop("a state on agent_" + std::to_string(neighbour) + "'s topic from " + event.getPublisherName() +
          ", which does not own it");
     return;

@@ -101,9 +101,10 @@ class LocalDelivery(unittest.TestCase):
         steps = self.check_every_step_from_first(self.early, 2)
         # It subscribed as the launch started; the late one waited for step 100 first.
         self.assertLess(steps[0], LATE_AFTER, "the early subscriber missed the start of the run")
-        # Published by agent_2's manager, and not latched: the manager's local delivery is on.
+        # Published by agent_2's manager, latched (live once a subscriber from outside connected:
+        # TopicAudience, test_topic_audience).
         self.assertEqual({h["callerid"] for h in self.early.headers}, {NS + "/manager_a"})
-        self.assertEqual({h.get("latching") for h in self.early.headers}, {"0"})
+        self.assertEqual({h.get("latching") for h in self.early.headers}, {"1"})
 
     def test_late_subscriber_gets_the_newest_then_every_state(self):
         self.assertGreaterEqual(self.seen_before_late, LATE_AFTER, "the run did not get past step 100")

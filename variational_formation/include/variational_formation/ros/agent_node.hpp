@@ -1,6 +1,7 @@
 #pragma once
 
 #include <deque>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -119,7 +120,7 @@ class AgentNode {
   std::deque<std::pair<int, AgentState::ConstPtr>> inbox_;
   bool inboxRead_ = false;  // a readInbox is due on the thread's lane
   std::vector<ros::Subscriber> subs_;
-  std::vector<std::string> owners_;           // full node names, by agent id
+  std::map<int, std::string> owners_;         // full node names of sources(), by agent id
   std::vector<std::string> managers_;         // ~agent_manager: nodelet managers of agents
   ros::Subscriber progressSub_, commandSub_;
   ros::ServiceServer recallServer_, historyServer_;

@@ -6,12 +6,18 @@
 namespace vf {
 
 /**
- * Who else needs an agent's state on its middleware topic, when its own process gets it from a
- * LocalExchange: the rule of doc/distributed.md, "Local delivery". The agent publishes on the topic
- * only while a subscriber outside its process is connected; a connection from its own process is
- * the other agents' (they listen to the exchange) and does not count. A subscriber that connects
- * gets the newest state at once, as the latched topic gave it before. Not thread-safe: the
- * publisher's connection callbacks and its publishing run on one thread (the agent's queue).
+ * Whether an agent's state must go out on its middleware topic, when its own process gets it from
+ * a LocalExchange: the rule of doc/distributed.md, "Local delivery". The topic stays silent until
+ * the first subscriber from outside the process connects (a connection from its own process is
+ * the other agents', which listen to the exchange, and does not count); from then on every state
+ * goes out on it, latched, for good. The connecting subscriber that makes it live is sent the
+ * newest state, and so is any other that connects before the first state goes out live; a later
+ * one gets it from the latch, which holds the newest then. Why for good: the middleware's latch
+ * and its broadcast hand a new subscriber the newest state exactly once, whenever its connection
+ * is made; a topic that went silent again would latch a stale state, and a state sent from the
+ * connect callback of a live topic may reach the subscriber twice (once broadcast, once sent).
+ * Not thread-safe: the publisher's connect callbacks and its publishing run on one thread (the
+ * agent's queue).
  */
 template <class State>
 class TopicAudience {
@@ -22,26 +28,24 @@ class TopicAudience {
   /// The agent published `state`. @return whether it must also go out on the topic.
   bool published(const State& state) {
     newest_ = state;
-    return outside_ > 0;
+    sentLive_ = sentLive_ || live_;
+    return live_;
   }
   /// Subscriber `name` connected. @return the state to send it now: the newest, or empty (none
-  /// yet, or `name` is this process).
+  /// yet, `name` is this process, or the topic's latch and broadcast already give it).
   State connected(const std::string& name) {
     if (name == self_) return State();
-    ++outside_;
-    return newest_;
+    live_ = true;
+    return sentLive_ ? State() : newest_;
   }
-  /// Subscriber `name` disconnected.
-  void disconnected(const std::string& name) {
-    if (name != self_ && outside_ > 0) --outside_;
-  }
-  /// How many subscribers outside this process are connected.
-  int outside() const { return outside_; }
+  /// Whether the topic is live (a subscriber from outside has connected).
+  bool live() const { return live_; }
 
  private:
   std::string self_;
   State newest_;
-  int outside_ = 0;
+  bool live_ = false;      // an outside subscriber connected: every state goes out on the topic
+  bool sentLive_ = false;  // a state went out on the live topic: its latch holds the newest
 };
 
 }  // namespace vf
