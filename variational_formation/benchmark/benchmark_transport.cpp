@@ -8,29 +8,47 @@
 // monitor gets them. Prints the steps/s from the first publication (remote: the first message
 // collected) to the last state collected.
 //
+// --delivery local (the default) hands the states between the agents of the process as an
+// agent_manager does (doc/distributed.md, "Local delivery"): through a LocalExchange, one queued
+// call per state and listener, each agent's topic silent until a subscriber in another
+// process connects (TopicAudience), so the in-process collector of `--collector topics`
+// listens to the exchange too. --delivery roscpp publishes every state on its topic, as before:
+// roscpp's publish finds the topic by a linear search through all of the process's publications,
+// so its cost per agent-step grows with the agents (doc/benchmarks.md).
+//
 // usage: benchmark_transport [--agents N] [--steps S] [--collector topics|batch] [--remote]
+//        [--delivery local|roscpp]
 //        (needs a master; benchmark/transport_ceiling.sh starts one)
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 
 #include "variational_formation_msgs/AgentState.h"
 #include "variational_formation_msgs/AgentStates.h"
+#include "variational_formation_core/protocol/local_exchange.hpp"
+#include "variational_formation_core/protocol/topic_audience.hpp"
+#include "variational_formation/ros/pacer.hpp"
 
 namespace {
 using variational_formation_msgs::AgentState;
 using variational_formation_msgs::AgentStates;
 
+using Exchange = vf::LocalExchange<AgentState::ConstPtr>;
+
 struct Agent {
   ros::Publisher pub;
+  std::unique_ptr<vf::TopicAudience<AgentState::ConstPtr>> audience;  // --delivery local
   std::vector<int> neighbours;
   std::vector<long> heard;  // newest step held of each neighbour
   long step = 0;
@@ -40,6 +58,7 @@ struct Bench {
   int n = 100;
   long steps = 2000;
   bool batch = false;
+  std::unique_ptr<Exchange> exchange;  // --delivery local: the agents' process hands states over itself
   std::vector<Agent> agents;
   std::vector<ros::Subscriber> subs;
   ros::Publisher batchPub;
@@ -53,7 +72,13 @@ struct Bench {
     msg->step = a.step;
     msg->position = {1.0 * i, 0.5 * a.step};
     msg->previous_position = {1.0 * i, 0.5 * (a.step - 1)};
-    a.pub.publish(AgentState::ConstPtr(msg));
+    const AgentState::ConstPtr state(msg);
+    if (!exchange) {
+      a.pub.publish(state);
+    } else {
+      exchange->deliver(i, state);
+      if (a.audience->published(state)) a.pub.publish(state);
+    }
     if (batch) {
       pending->states.push_back(*msg);
       if (static_cast<int>(pending->states.size()) == n) {
@@ -77,12 +102,19 @@ struct Bench {
     a.heard[k] = std::max(a.heard[k], static_cast<long>(msg->step));
     tryAdvance(i);
   }
+  /// --delivery local: f(state) on the global queue (the one spinner) for each state of `source`.
+  template <class F>
+  void listen(int source, std::uintptr_t listener, F f) {
+    exchange->listen(source, listener, [f](int, const AgentState::ConstPtr& m) {
+      vf::queueCall(ros::getGlobalCallbackQueue(), [f, m] { f(m); }, 0);
+    });
+  }
 };
 }  // namespace
 
 int main(int argc, char** argv) {
   Bench b;
-  bool remote = false;
+  bool remote = false, local = true;
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
     const bool value = k + 1 < argc;
@@ -99,8 +131,16 @@ int main(int argc, char** argv) {
       b.batch = c == "batch";
     } else if (a == "--remote") {
       remote = true;
+    } else if (a == "--delivery" && value) {
+      const std::string d = argv[++k];
+      if (d != "local" && d != "roscpp") {
+        std::fprintf(stderr, "benchmark_transport: --delivery: local or roscpp, got '%s'\n", d.c_str());
+        return 2;
+      }
+      local = d == "local";
     } else if (a == "--help" || a == "-h") {
-      std::puts("usage: benchmark_transport [--agents N] [--steps S] [--collector topics|batch] [--remote]");
+      std::puts("usage: benchmark_transport [--agents N] [--steps S] [--collector topics|batch] [--remote] "
+                "[--delivery local|roscpp]");
       return 0;
     } else {
       std::fprintf(stderr, "benchmark_transport: unknown or incomplete argument '%s' (see --help)\n", a.c_str());
@@ -131,8 +171,27 @@ int main(int argc, char** argv) {
       ros::shutdown();
     }
   };
+  if (local && runsAgents) {
+    std::vector<int> ids;
+    for (int i = 0; i < b.n; ++i) ids.push_back(i);
+    b.exchange = std::make_unique<Exchange>(ids);
+  }
   for (int i = 0; i < b.n; ++i) {
-    b.agents[static_cast<std::size_t>(i)].pub = nh.advertise<AgentState>("agent_" + std::to_string(i), 1000);
+    Agent& a = b.agents[static_cast<std::size_t>(i)];
+    if (!b.exchange) {
+      a.pub = nh.advertise<AgentState>("agent_" + std::to_string(i), 1000);
+      continue;
+    }
+    a.audience = std::make_unique<vf::TopicAudience<AgentState::ConstPtr>>(ros::this_node::getName());
+    vf::TopicAudience<AgentState::ConstPtr>* audience = a.audience.get();
+    ros::AdvertiseOptions options = ros::AdvertiseOptions::create<AgentState>(
+        "agent_" + std::to_string(i), 1000,
+        [audience](const ros::SingleSubscriberPublisher& s) {
+          if (const AgentState::ConstPtr newest = audience->connected(s.getSubscriberName())) s.publish(*newest);
+        },
+        ros::SubscriberStatusCallback(), ros::VoidConstPtr(), nullptr);
+    options.latch = true;  // as an agent_manager's agents (TopicAudience)
+    a.pub = nh.advertise(options);
   }
   if (b.batch) b.batchPub = nh.advertise<AgentStates>("states", 1000);
   for (int i = 0; i < b.n; ++i) {
@@ -140,10 +199,16 @@ int main(int argc, char** argv) {
     for (int d : {-2, -1, 1, 2}) a.neighbours.push_back((i + d + b.n) % b.n);
     a.heard.assign(a.neighbours.size(), 0);
     for (std::size_t k = 0; runsAgents && k < a.neighbours.size(); ++k) {
+      if (b.exchange) {
+        b.listen(a.neighbours[k], static_cast<std::uintptr_t>(i), [&b, i, k](const AgentState::ConstPtr& m) { b.onNeighbour(i, k, m); });
+        continue;
+      }
       b.subs.push_back(nh.subscribe<AgentState>("agent_" + std::to_string(a.neighbours[k]), 1000,
                                                 [&b, i, k](const AgentState::ConstPtr& m) { b.onNeighbour(i, k, m); }));
     }
-    if (collects && !b.batch) {
+    if (collects && !b.batch && b.exchange) {  // the collector in the agents' process
+      b.listen(i, static_cast<std::uintptr_t>(b.n + i), [&count](const AgentState::ConstPtr& m) { count(m->step > 0 ? 1 : 0); });
+    } else if (collects && !b.batch) {
       b.subs.push_back(nh.subscribe<AgentState>("agent_" + std::to_string(i), 1000,
                                                 [&count](const AgentState::ConstPtr& m) { count(m->step > 0 ? 1 : 0); }));
     }
@@ -172,8 +237,8 @@ int main(int argc, char** argv) {
     }
   }
   const double seconds = std::chrono::duration<double>(done - start).count();
-  std::printf("benchmark_transport: %d agents, %ld steps, collector %s%s: %.3f s, %.0f steps/s\n", b.n, b.steps,
-              b.batch ? "batch" : "topics", remote ? " (another process)" : " (this process)", seconds,
-              b.steps / seconds);
+  std::printf("benchmark_transport: %d agents, %ld steps, collector %s%s, %s delivery: %.3f s, %.0f steps/s\n", b.n,
+              b.steps, b.batch ? "batch" : "topics", remote ? " (another process)" : " (this process)",
+              local ? "local" : "roscpp", seconds, b.steps / seconds);
   return b.collected >= total ? 0 : 1;
 }

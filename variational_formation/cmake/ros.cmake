@@ -6,6 +6,7 @@ add_library(variational_formation_ros
   src/ros/formation_subscriptions.cpp
   src/ros/frames.cpp
   src/ros/liveness.cpp
+  src/ros/local_states.cpp
   src/ros/markers.cpp
   src/ros/monitor_node.cpp
   src/ros/output_files.cpp
@@ -121,6 +122,8 @@ if(CATKIN_ENABLE_TESTING)
   add_rostest(test/ros/render.test ARGS kind:=robots)
   # The same with world:=mujoco: the world's markers (bodies, headings, contacts) in the bag and video.
   add_rostest(test/ros/render.test ARGS kind:=mujoco)
+  # Local delivery in two agent_managers: subscribers outside get every state, a late one the newest.
+  add_rostest(test/ros/local_delivery.test)
   # SIGKILL to the nodelet manager of every agent during a recorded run: test/ros/nodelet_fault.test.
   add_rostest(test/ros/nodelet_fault.test ARGS seed:=3)
   # Lockstep with the safety filter on (test/ros/safety_run.test, doc/distributed.md "Sensing"):
@@ -155,5 +158,5 @@ install(TARGETS robot_sim RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 # checkout only, like benchmark_roa.
 add_executable(benchmark_transport benchmark/benchmark_transport.cpp)
 add_dependencies(benchmark_transport ${catkin_EXPORTED_TARGETS})
-target_link_libraries(benchmark_transport ${catkin_LIBRARIES})
+target_link_libraries(benchmark_transport ${variational_formation_core_LIBRARIES} ${catkin_LIBRARIES})
 target_compile_options(benchmark_transport PRIVATE ${VF_FLAGS})

@@ -16,6 +16,7 @@
 #include <ros/ros.h>
 
 #include "variational_formation_core/common/invalid_input.hpp"
+#include "variational_formation/ros/local_states.hpp"
 #include "variational_formation/ros/node_main.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/sensing_hub.hpp"
@@ -69,10 +70,13 @@ int main(int argc, char** argv) {
     if (!(stagger >= 0.0 && std::isfinite(stagger))) throw vf::InvalidInput("~stagger: must be >= 0 seconds");
     // One message per step with all of its agents' states, for the monitor and the recorder.
     vf::StateBatch::start(pnh, ids);
+    // Its agents hand their states to each other in this process (doc/distributed.md, "Local delivery").
+    vf::LocalStates::start(nh, ids);
     struct StopBatch {
       ~StopBatch() {  // after the loader (declared below) unloaded the agents
         vf::SensingHub::stop();
         vf::StateBatch::stop();
+        vf::LocalStates::stop();
       }
     } stopBatch;
     // The agents' callbacks run on this process's own threads, one per ~num_worker_threads (0:

@@ -29,13 +29,15 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   const std::string path = requiredParam<std::string>(pnh, "scenario");
   realTimeFactor_ = optionalParam(pnh, "real_time_factor", 0.0);
   monitor_ = participantName(nh, optionalParam<std::string>(pnh, "monitor", "monitor"));
-  const Scenario scenario = sharedScenario(path);
+  // One scenario and formation for all the agents of the process, not a copy each.
+  const std::shared_ptr<const Scenario> shared = sharedScenarioObject(path);
+  const Scenario& scenario = *shared;
   validateRealTimeFactor(realTimeFactor_, scenario.timeStep, "~real_time_factor");
   managers_ = agentManagers(nh, pnh);
   const std::shared_ptr<SensingBoard> board = SensingHub::board(nh, scenario, managers_);
   sharedBoard_ = board != nullptr;
   protocol_ = std::make_unique<Protocol>(
-      LockstepAgent(scenario, id, StartMethod::Variational, board),
+      LockstepAgent(shared, sharedFormation(shared), id, StartMethod::Variational, board),
       [this](const LockstepAgent& a, const std::string& failure) { return makeState(a, failure); }, realTimeFactor_,
       [] { return ros::WallTime::now().toSec(); }, Pacer::kGrain);
   name_ = "agent_" + std::to_string(id);
@@ -43,8 +45,11 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   const std::string ns = framePrefix(nh);
   frame_ = ns + name_;
   worldFrame_ = worldFrame(pnh);
-  statePub_ = nh.advertise<AgentState>(name_ + "/state", 1000, /*latch=*/true);
-  for (int j = 0; j < scenario.agentCount(); ++j) owners_.push_back(agentNodeName(nh, j));
+  exchange_ = LocalStates::of(nh);
+  if (exchange_ && !exchange_->hosts(id)) exchange_ = nullptr;
+  if (exchange_) LocalStates::place(id, nh.getCallbackQueue());
+  advertiseState(nh);
+  for (int j : sources()) owners_[j] = agentNodeName(nh, j);  // only whose topics it reads
   // Served from the start, so that restarting neighbours can ask; the subscriptions wait for
   // start(), which resumes the agent before any state reaches it.
   recallServer_ = nh.advertiseService(name_ + "/recall", &AgentNode::onRecall, this);
@@ -61,7 +66,27 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   }
 }
 
+void AgentNode::advertiseState(ros::NodeHandle& nh) {
+  if (!exchange_) {
+    statePub_ = nh.advertise<AgentState>(name_ + "/state", 1000, /*latch=*/true);
+    return;
+  }
+  audience_ = std::make_unique<TopicAudience<AgentState::ConstPtr>>(ros::this_node::getName());
+  // Connections are reported on this agent's queue, where it publishes: no lock is needed.
+  const std::shared_ptr<bool> alive = alive_;
+  ros::AdvertiseOptions options = ros::AdvertiseOptions::create<AgentState>(
+      name_ + "/state", 1000,
+      [this, alive](const ros::SingleSubscriberPublisher& s) {
+        if (!*alive) return;
+        if (const AgentState::ConstPtr newest = audience_->connected(s.getSubscriberName())) s.publish(*newest);
+      },
+      ros::SubscriberStatusCallback(), ros::VoidConstPtr(), nullptr);
+  options.latch = true;  // once live (TopicAudience): the latch hands a new subscriber the newest
+  statePub_ = nh.advertise(options);
+}
+
 AgentNode::~AgentNode() {
+  if (exchange_) exchange_->stopListening(reinterpret_cast<std::uintptr_t>(this));
   *alive_ = false;
   Pacer::instance().cancel(reinterpret_cast<uint64_t>(this));
 }
@@ -116,7 +141,9 @@ void AgentNode::paceFor(double wait) {
 }
 
 void AgentNode::onNeighbourState(int neighbour, const ros::MessageEvent<AgentState const>& event) {
-  if (!fromAgent(event, owners_[static_cast<std::size_t>(neighbour)], managers_)) {
+  // From this process, a local neighbour's state reached the agent through the exchange already.
+  if (exchange_ && exchange_->hosts(neighbour) && event.getPublisherName() == ros::this_node::getName()) return;
+  if (!fromAgent(event, owners_.at(neighbour), managers_)) {
     drop("a state on agent_" + std::to_string(neighbour) + "'s topic from " + event.getPublisherName() +
          ", which does not own it");
     return;
@@ -152,7 +179,12 @@ AgentState::ConstPtr AgentNode::makeState(const LockstepAgent& a, const std::str
 }
 
 void AgentNode::publish(const AgentState::ConstPtr& state) {
-  statePub_.publish(state);
+  if (!exchange_) {
+    statePub_.publish(state);
+  } else {
+    exchange_->deliver(agent().id(), state);
+    if (audience_->published(state)) statePub_.publish(state);
+  }
   if (StateBatch* batch = StateBatch::local()) batch->add(state);  // in an agent_manager
   tf_.sendTransform(frameAt(state->header, frame_, state->position));
 }
@@ -166,12 +198,51 @@ void AgentNode::reportWaiting() {
   lastReportAt_ = ros::WallTime::now();
 }
 
+void AgentNode::listenLocally() {
+  if (!exchange_) return;
+  ros::CallbackQueueInterface* queue = nh_.getCallbackQueue();
+  const std::shared_ptr<bool> alive = alive_;
+  for (int j : sources()) {
+    if (!exchange_->hosts(j)) continue;
+    // A neighbour on this agent's thread: into the inbox, read right after the callback that
+    // published it (depth first: the state is still in the cache). One on another thread: a
+    // call on this agent's queue. Either way per neighbour, so its states stay in order.
+    // (The neighbour's queue is placed before it publishes anything that reaches this handler.)
+    exchange_->listen(j, reinterpret_cast<std::uintptr_t>(this),
+                      [this, queue, alive](int source, const AgentState::ConstPtr& state) {
+                        if (LocalStates::queueOf(source) == queue && AgentThreads::serves(queue)) {
+                          inbox_.emplace_back(source, state);
+                          if (!inboxRead_) {
+                            inboxRead_ = true;
+                            AgentThreads::soon([this, alive] {
+                              if (*alive) readInbox();
+                            });
+                          }
+                          return;
+                        }
+                        queueCall(queue, [this, alive, source, state] {
+                          if (*alive) carryOut(protocol_->step(Protocol::StateArrived{source, state}));
+                        }, reinterpret_cast<uint64_t>(this));
+                      });
+  }
+}
+
+void AgentNode::readInbox() {
+  inboxRead_ = false;
+  while (!inbox_.empty()) {
+    const std::pair<int, AgentState::ConstPtr> arrived = std::move(inbox_.front());
+    inbox_.pop_front();
+    carryOut(protocol_->step(Protocol::StateArrived{arrived.first, arrived.second}));
+  }
+}
+
 void AgentNode::start(const Recovery& recovery) {
   resume(recovery);
   subscribeToFormation(
       nh_, sources(), 1000,
       [this](int j, const ros::MessageEvent<AgentState const>& e) { onNeighbourState(j, e); },
       [this](const ros::MessageEvent<RunProgress const>& e) { onProgress(e); }, subs_, progressSub_);
+  listenLocally();
   commandSub_ = nh_.subscribe<variational_formation_msgs::FormationCommands>(
       "command", 10,
       boost::function<void(const ros::MessageEvent<variational_formation_msgs::FormationCommands const>&)>(

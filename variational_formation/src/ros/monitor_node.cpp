@@ -52,7 +52,15 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh, bool timed) 
   }
   // Latched: a viewer or recorder that connects late still gets the newest step.
   statusPub_ = nh.advertise<FormationStatus>("status", 1000, true);
-  markersPub_ = nh.advertise<visualization_msgs::MarkerArray>("markers", 1000, true);
+  // A viewer is a subscriber of the markers other than the recorder (which reads them too).
+  const std::string recorder = recording_ ? participantName(nh, recorderParam_) : "";
+  markersPub_ = nh.advertise<visualization_msgs::MarkerArray>(
+      "markers", 1000,
+      [this, recorder](const ros::SingleSubscriberPublisher& s) { viewers_ += s.getSubscriberName() != recorder; },
+      [this, recorder](const ros::SingleSubscriberPublisher& s) {
+        if (s.getSubscriberName() != recorder && viewers_ > 0) --viewers_;
+      },
+      ros::VoidConstPtr(), true);
   progressPub_ = nh.advertise<RunProgress>("progress", 10, true);
   if (publishClock_) clockPub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
   // A manager's agents come in its batches (one message per step), the others on their own topics.

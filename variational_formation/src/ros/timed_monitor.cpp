@@ -35,7 +35,7 @@ void TimedMonitor::begin() {
   tickTimer_ = nh_.createWallTimer(ros::WallDuration(scenario_.timeStep / rate_),
                                    [this](const ros::WallTimerEvent&) {
                                      carryOut(referee_->step(protocol::TimedReferee<AgentState>::Tick{
-                                         ros::WallTime::now().toSec(), markersPub_.getNumSubscribers() > 0,
+                                         ros::WallTime::now().toSec(), viewer(),
                                          lastCommandStep()}));
                                    });
   ROS_INFO("monitor: timed mode: status every %g s from each agent's newest state; the Noether predictions do "

@@ -8,10 +8,15 @@
 
 namespace vf {
 
-AgentNeighbourhood::AgentNeighbourhood(const Scenario& scenario, int id)
-    : model_(std::make_shared<const Formation>(makeFormation(scenario))), id_(id) {
+AgentNeighbourhood::AgentNeighbourhood(const Scenario& scenario, int id, std::shared_ptr<const Formation> shared)
+    : model_(shared ? std::move(shared) : std::make_shared<const Formation>(makeFormation(scenario))), id_(id) {
+  const int n = model_.formation().agentCount();
+  if (n != scenario.agentCount() || model_.formation().dimension() != scenario.dimension) {
+    throw InvalidInput("formation: " + std::to_string(n) + " agents in " + std::to_string(model_.formation().dimension()) +
+                       " dimensions for a scenario of " + std::to_string(scenario.agentCount()) + " in " +
+                       std::to_string(scenario.dimension));
+  }
   const Formation& formation = model_.formation();
-  const int n = formation.agentCount();
   if (id < 0 || id >= n) {
     throw InvalidInput("id: must be an agent id 0.." + std::to_string(n - 1) + ", got " + std::to_string(id));
   }

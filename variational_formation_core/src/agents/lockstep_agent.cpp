@@ -8,12 +8,17 @@
 namespace vf {
 
 LockstepAgent::LockstepAgent(const Scenario& scenario, int id, StartMethod start, std::shared_ptr<SensingBoard> board)
-    : scenario_(scenario),
-      neighbourhood_(scenario, id),  // checks the id
-      coefficients_(scenario.timeStep, scenario.dampingGain),
+    : LockstepAgent(std::make_shared<const Scenario>(scenario), nullptr, id, start, std::move(board)) {}
+
+LockstepAgent::LockstepAgent(std::shared_ptr<const Scenario> shared, std::shared_ptr<const Formation> formation, int id,
+                             StartMethod start, std::shared_ptr<SensingBoard> board)
+    : scenario_(std::move(shared)),
+      neighbourhood_(*scenario_, id, std::move(formation)),  // checks the id
+      coefficients_(scenario_->timeStep, scenario_->dampingGain),
       start_(start),
       id_(id),
-      dimension_(scenario.dimension) {
+      dimension_(scenario_->dimension) {
+  const Scenario& scenario = *scenario_;
   q_ = neighbourhood_.initialPosition();
   qPrev_ = q_;
   qBeforePrev_ = q_;
@@ -83,7 +88,7 @@ std::string LockstepAgent::describe(Receipt receipt) {
 LockstepAgent::Receipt LockstepAgent::receive(long sender, long step,
                                               const std::vector<double>& position,
                                               const std::vector<double>& previousPosition) {
-  if (board_ && sender != id_ && sender >= 0 && sender < scenario_.agentCount() && !isNeighbour(sender)) {
+  if (board_ && sender != id_ && sender >= 0 && sender < scenario_->agentCount() && !isNeighbour(sender)) {
     // A sensed agent (doc/distributed.md, "Sensing"): the barrier keeps it within one step, as
     // a neighbour.
     if (position.size() != static_cast<std::size_t>(dimension_) ||
@@ -156,8 +161,8 @@ void LockstepAgent::filter(double* next) {
   previousConstraintsActive_ = constraintsActive_;
   if (!board_) return;
   board_->sensed(id_, step_, sensed_);
-  filterNextPosition(*scenario_.safety, coefficients_.timeStep, dimension_, q_.data(), next, sensed_,
-                     scenario_.obstacles, safeStep_);
+  filterNextPosition(*scenario_->safety, coefficients_.timeStep, dimension_, q_.data(), next, sensed_,
+                     scenario_->obstacles, safeStep_);
   constraintsActive_ = static_cast<int>(safeStep_.projection.active.size());
 }
 

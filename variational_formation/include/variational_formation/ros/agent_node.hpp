@@ -1,5 +1,7 @@
 #pragma once
 
+#include <deque>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -12,6 +14,8 @@
 #include "variational_formation_msgs/RecallHistory.h"
 #include "variational_formation_msgs/RecallState.h"
 #include "variational_formation_msgs/RunProgress.h"
+#include "variational_formation/ros/local_states.hpp"
+#include "variational_formation_core/protocol/topic_audience.hpp"
 #include "variational_formation/ros/periodic_call.hpp"
 #include "variational_formation/ros/recalled.hpp"
 #include "variational_formation_core/agents/lockstep_agent.hpp"
@@ -46,6 +50,12 @@ using variational_formation_msgs::RunProgress;
  * agent's state at each step (doc/distributed.md, "Sensing"): in an agent_manager from the board
  * the manager's agents share (SensingHub), elsewhere from every agent's state topic.
  *
+ * In an agent_manager, its own agents hand their states to each other through the manager's
+ * LocalExchange (doc/distributed.md, "Local delivery"), and an agent publishes on its topic only
+ * while a subscriber outside the process is connected (TopicAudience), each new one getting the
+ * newest state at once; it still subscribes to its local neighbours' topics, where it drops
+ * states that others forge.
+ *
  * Topics, services and private parameters (types, defaults, meaning): doc/ros_api.md, "agent
  * (lockstep mode)", the one list (test/doc/test_docs.py keeps it in step with the code).
  */
@@ -74,6 +84,12 @@ class AgentNode {
   using Protocol = protocol::AgentProtocol<AgentState::ConstPtr, RunProgress>;
 
   void onNeighbourState(int neighbour, const ros::MessageEvent<AgentState const>& event);
+  /// Takes the neighbours' states that the manager's exchange holds from it (on this agent's queue).
+  void listenLocally();
+  /// The states in inbox_, oldest first.
+  void readInbox();
+  /// Advertises the state topic: latched, or with the exchange, gated by the audience.
+  void advertiseState(ros::NodeHandle& nh);
   /// With a shared board: a Wake on this agent's queue once the board holds step k.
   void wakeWhenSensed();
   /// Whose states it subscribes to: its neighbours, and with an own board every other agent.
@@ -101,8 +117,13 @@ class AgentNode {
   ros::NodeHandle nh_;
   std::unique_ptr<Protocol> protocol_;
   ros::Publisher statePub_;
+  LocalStates::Exchange* exchange_ = nullptr;  // the manager's, if it hosts this agent
+  std::unique_ptr<TopicAudience<AgentState::ConstPtr>> audience_;  // with exchange_: who else needs the topic
+  // States of neighbours on this agent's thread, handed over by the exchange (AgentThreads::soon).
+  std::deque<std::pair<int, AgentState::ConstPtr>> inbox_;
+  bool inboxRead_ = false;  // a readInbox is due on the thread's lane
   std::vector<ros::Subscriber> subs_;
-  std::vector<std::string> owners_;           // full node names, by agent id
+  std::map<int, std::string> owners_;         // full node names of sources(), by agent id
   std::vector<std::string> managers_;         // ~agent_manager: nodelet managers of agents
   ros::Subscriber progressSub_, commandSub_;
   ros::ServiceServer recallServer_, historyServer_;

@@ -54,6 +54,8 @@ class MonitorNode {
   int run();
 
  protected:
+  /// A subscriber of the markers other than the recorder (rviz) is connected (~wait_for_viewer).
+  bool viewer() const { return viewers_ > 0; }
   struct Participant {
     std::string node;         // full node name
     bool seen = false;        // has sent a valid message
@@ -169,6 +171,7 @@ class MonitorNode {
   bool recording_ = false;     // a recorder takes part (lockstep)
   long window_ = 100;
   bool waitForViewer_ = false;
+  int viewers_ = 0;  // subscribers of the markers other than the recorder (~wait_for_viewer)
   double respawnTimeout_ = 0.0;
   std::vector<std::string> managers_;  // ~agent_manager: nodelet managers of agents
   std::vector<Participant> agents_;
@@ -271,7 +274,6 @@ class LockstepMonitor : public MonitorNode {
   bool onHistory(RecallHistory::Request& request, RecallHistory::Response& response);
   /// The referee's Update: each completed step, then the progress.
   void updateProgress() { carryOut(referee_->step(Referee::Update{viewer()})); }
-  bool viewer() const { return markersPub_.getNumSubscribers() > 0; }
   /// Does what `r` says, in its order (RefereeReady).
   void carryOut(const Referee::Ready& r);
   /// The states agents `ids` hold of themselves (`~history`), in order of `ids`.

@@ -9,6 +9,7 @@
 #include <thread>
 
 #include <ros/callback_queue_interface.h>
+#include <ros/forwards.h>  // boost::make_shared, without a boost include of the package's own
 
 namespace vf {
 
@@ -24,6 +25,27 @@ class QueuedCall : public ros::CallbackInterface {
  private:
   std::function<void()> f_;
 };
+
+/// The same for a callable of type F, in one allocation (no std::function): one per state an
+/// agent manager hands from one agent to another.
+template <class F>
+class CallOnce : public ros::CallbackInterface {
+ public:
+  explicit CallOnce(F f) : f_(std::move(f)) {}
+  CallResult call() override {
+    f_();
+    return Success;
+  }
+
+ private:
+  F f_;
+};
+
+/// Adds f to `queue` as a CallOnce, under removal id `owner`.
+template <class F>
+void queueCall(ros::CallbackQueueInterface* queue, F f, uint64_t owner) {
+  queue->addCallback(boost::make_shared<CallOnce<F>>(std::move(f)), owner);
+}
 
 /**
  * Releases paced steps (an agent at real_time_factor > 0) for every agent of a process from one

@@ -1,7 +1,9 @@
 #pragma once
 
 #include <condition_variable>
+#include <deque>
 #include <atomic>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -48,6 +50,11 @@ class StateBatch {
   /// of the process a search through all of them each time it fires (TimerManager::findTimer).
   void flushEvery5ms();
   void flush();
+  /// The pending batch, cut to the states added, and a new pending one (a spent batch no one
+  /// holds any more, or a new one). Under mutex_.
+  variational_formation_msgs::AgentStatesPtr takePending();
+  /// Publishes `batch`, then keeps it among the spent ones.
+  void publish(const variational_formation_msgs::AgentStatesPtr& batch);
   /// A subscriber that connects gets each agent's newest state at once, as the latched
   /// agent_<i>/state topics give it (a monitor or recorder started late misses nothing).
   void onConnect(const ros::SingleSubscriberPublisher& subscriber);
@@ -55,7 +62,10 @@ class StateBatch {
   std::set<int> ids_;
   std::mutex mutex_;
   variational_formation_msgs::AgentStatesPtr pending_;
-  std::map<int, variational_formation_msgs::AgentState::ConstPtr> newest_;
+  std::size_t filled_ = 0;  // states added to pending_ (a reused batch holds old ones after them)
+  std::deque<variational_formation_msgs::AgentStatesPtr> spent_;  // published, oldest first
+  std::vector<char> batched_;  // by agent id: in ids_ (a look-up per state, not a tree search)
+  std::vector<variational_formation_msgs::AgentState::ConstPtr> newest_;  // by agent id; guarded by mutex_
   ros::Publisher pub_;
   bool stopping_ = false;  // guarded by mutex_
   std::condition_variable stop_;
@@ -83,6 +93,15 @@ class AgentThreads {
   static AgentThreads* local();
   /// The queue of the next agent loaded.
   ros::CallbackQueue* nextQueue();
+  /// Whether the calling thread is the one that serves `queue`.
+  static bool serves(const ros::CallbackQueueInterface* queue);
+  /**
+   * Runs `work` on the calling thread (one of these threads) after the callback that adds it, the
+   * newest added first, ahead of the queue's later callbacks but interleaved with them (64 at a
+   * time): a state handed from one agent to a neighbour on the same thread is read while it is
+   * still in the cache (doc/distributed.md, "Local delivery"). Only from one of these threads.
+   */
+  static void soon(std::function<void()> work);
   ~AgentThreads();
 
  private:

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "variational_formation_core/model/force_model.hpp"
@@ -19,8 +20,12 @@ class AgentNeighbourhood {
   /// Why a neighbour's state cannot be used.
   enum class StateCheck { Usable, UnknownSender, WrongDimension, NonFinite };
 
-  /// @throws InvalidInput if id is not an agent of the (validated) scenario.
-  AgentNeighbourhood(const Scenario& scenario, int id);
+  /**
+   * @param formation makeFormation(scenario), shared with other agents; nullptr: one of its own.
+   * @throws InvalidInput if id is not an agent of the (validated) scenario, or `formation` is
+   * not of the scenario's size.
+   */
+  AgentNeighbourhood(const Scenario& scenario, int id, std::shared_ptr<const Formation> formation = nullptr);
 
   int id() const { return id_; }
   int dimension() const { return model_.dimension(); }

@@ -43,6 +43,13 @@ class LockstepAgent {
    */
   LockstepAgent(const Scenario& scenario, int id, StartMethod start = StartMethod::Variational,
                 std::shared_ptr<SensingBoard> board = nullptr);
+  /**
+   * The same over a scenario and its formation (makeFormation(*scenario)) shared by the agents of
+   * one process: n agents hold one copy, not n (doc/distributed.md, "Local delivery").
+   * @throws InvalidInput as above, or if `formation` is not of the scenario's size.
+   */
+  LockstepAgent(std::shared_ptr<const Scenario> scenario, std::shared_ptr<const Formation> formation, int id,
+                StartMethod start = StartMethod::Variational, std::shared_ptr<SensingBoard> board = nullptr);
 
   /// Offers neighbour `sender`'s state (with `safety:`, any other agent's) at step m (q_m, q_{m-1}); never changes the agent's own
   /// state, and keeps nothing unless the state is Accepted.
@@ -98,13 +105,13 @@ class LockstepAgent {
   long step() const { return step_; }
   double time() const { return static_cast<double>(step_) * coefficients_.timeStep; }
   /// scenario steps reached (never for steps = 0, unbounded).
-  bool finished() const { return scenario_.steps > 0 && step_ >= scenario_.steps; }
+  bool finished() const { return scenario_->steps > 0 && step_ >= scenario_->steps; }
   /// advance() ran since the start or the last resume().
   bool advancedSinceResume() const { return advanced_; }
   const std::vector<double>& position() const { return q_; }
   const std::vector<double>& previousPosition() const { return qPrev_; }
   const std::vector<int>& neighbourIds() const { return neighbourhood_.neighbourIds(); }
-  const Scenario& scenario() const { return scenario_; }
+  const Scenario& scenario() const { return *scenario_; }
 
   static std::string describe(Receipt receipt);
 
@@ -124,7 +131,7 @@ class LockstepAgent {
   /// Puts its own q_k on the board.
   void offerOwn();
 
-  Scenario scenario_;
+  std::shared_ptr<const Scenario> scenario_;  // possibly shared with the process's other agents
   // The formation as this agent knows it: its start, neighbours, the checks of a neighbour's
   // state, grad_i V (scaled under a command) and its centroid offset.
   AgentNeighbourhood neighbourhood_;
