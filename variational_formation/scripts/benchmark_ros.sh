@@ -3,9 +3,14 @@
 #   process: one process per agent (formation.launch scenario:=FILE)
 #   nodelet: every agent in one nodelet manager, agent_manager (formation.launch scenario:=FILE nodelet:=true);
 #            n/a while the launch file has no `nodelet` argument or its launch fails.
+#   sharded: the agents split into VF_BENCH_SHARDS (default 5) agent_managers of consecutive ids,
+#            each written by make_agents_launch.py as for a machine of doc/distributed.md,
+#            "Sharded managers", all on this machine; formation.launch agents:=false takes their
+#            batches (agent_manager:=those managers).
 # Each run is a ring with chords to the second neighbour written by make_scenario (spacing 1 m,
-# start perturbed by up to 0.05 m per coordinate, seed 1, kappa 2, h = 0.005 s), run as fast as
-# possible without recording, on its own ROS master (a free port in 11500-11599).
+# start perturbed by up to 0.05 m per coordinate, seed 1, kappa 2, h = 0.005 s; above the 2000
+# agents make_scenario writes, the same layout from benchmark/simulate_scaling.py), run as fast
+# as possible without recording, on its own ROS master (a free port in 11500-11599).
 # Columns:
 #   steps/s, real-time factor: the monitor's final line, from step 0 to the last step;
 #   CPU%/agent: CPU time of the processes hosting agents (`agent` and `agent_manager` processes under
@@ -19,7 +24,7 @@
 #     recorded throughput) and benchmark/bag_vs_simulate.py compares every state of the bag with
 #     simulate, bit for bit: yes or no; "-" without recording.
 # usage: ./scripts/benchmark_ros.sh [agent counts...]          (default 6 20 50 100 200)
-# environment: VF_BENCH_MODES (default "process nodelet"), VF_BENCH_STEPS (steps per run;
+# environment: VF_BENCH_MODES (default "process nodelet"; also sharded), VF_BENCH_SHARDS (default 5), VF_BENCH_STEPS (steps per run;
 #   default max(600, 120000 / agents), about 10-40 s per run), VF_BENCH_TIMEOUT (s per run,
 #   default 900), VF_BENCH_SAMPLE (s between samples, default 0.5), VF_BENCH_RECORD (1: record and
 #   check exactness; default 0), VF_BENCH_PORT_BASE and VF_BENCH_PORTS (the masters' port range,
@@ -94,10 +99,42 @@ mode_supported() {
   roslaunch --ros-args variational_formation formation.launch 2>/dev/null | grep -E "^ +$1[ :(]" >/dev/null
 }
 
+# The launch file of a sharded run (mode sharded): VF_BENCH_SHARDS managers of consecutive ids,
+# each one make_agents_launch.py writes, and formation.launch without agents over their batches.
+# Its arguments (scenario, record, ...) go to formation.launch. Prints its path.
+sharded_launch() {
+  local scenario="$1" n="$2" dir="$3" shards="${VF_BENCH_SHARDS:-5}" k managers=""
+  mkdir -p "$dir"
+  for ((k = 0; k < shards; k++)); do managers+="${managers:+ }manager_$k"; done
+  {
+    echo "<launch>"
+    echo '  <arg name="scenario"/>'
+    echo '  <arg name="record" default="false"/>'
+    echo '  <arg name="record_max_size" default="0"/>'
+    echo '  <arg name="output_dir" default="$(env HOME)/.ros/vf_output"/>'
+    for ((k = 0; k < shards; k++)); do
+      rosrun variational_formation make_agents_launch.py --scenario "$scenario" --nodelet true \
+        --ids "$((k * n / shards))-$(((k + 1) * n / shards - 1))" --manager-name "manager_$k" \
+        --agent-manager "$managers" --out "$dir/shard_$k.launch" >/dev/null
+      echo "  <include file=\"$dir/shard_$k.launch\"/>"
+    done
+    echo '  <include file="$(find variational_formation)/launch/formation.launch">'
+    echo '    <arg name="scenario" value="$(arg scenario)"/>'
+    echo '    <arg name="agents" value="false"/>'
+    echo "    <arg name=\"agent_manager\" value=\"$managers\"/>"
+    echo '    <arg name="record" value="$(arg record)"/>'
+    echo '    <arg name="record_max_size" value="$(arg record_max_size)"/>'
+    echo '    <arg name="output_dir" value="$(arg output_dir)"/>'
+    echo "  </include>"
+    echo "</launch>"
+  } >"$dir/sharded.launch"
+  echo "$dir/sharded.launch"
+}
+
 declare -A skip
 for m in "${modes[@]}"; do
-  case "$m" in process|nodelet) ;; *) echo "benchmark_ros: VF_BENCH_MODES: unknown mode '$m' (process, nodelet)" >&2; exit 2 ;; esac
-  mode_supported "$m" || { skip[$m]=1; echo "benchmark_ros: formation.launch has no '$m' argument: $m is n/a" >&2; }
+  case "$m" in process|nodelet|sharded) ;; *) echo "benchmark_ros: VF_BENCH_MODES: unknown mode '$m' (process, nodelet, sharded)" >&2; exit 2 ;; esac
+  [ "$m" = sharded ] || mode_supported "$m" || { skip[$m]=1; echo "benchmark_ros: formation.launch has no '$m' argument: $m is n/a" >&2; }
 done
 
 row() { printf '%7s %-8s %7s %9s %17s %11s %14s %8s %6s\n' "$@"; }
@@ -105,8 +142,13 @@ row agents mode steps "steps/s" "real-time factor" "CPU%/agent" "RSS MiB/agent" 
 for n in "${counts[@]}"; do
   steps="${VF_BENCH_STEPS:-$(( 120000 / n > 600 ? 120000 / n : 600 ))}"
   scenario="$tmp/ring$n.yaml"
-  rosrun variational_formation make_scenario --shape ring --agents "$n" --perturb 0.05 --seed 1 \
-    --steps "$steps" --name "ring$n" --out "$scenario" ${VF_BENCH_MAKE_FLAGS:-}
+  if [ "$n" -le 2000 ]; then
+    rosrun variational_formation make_scenario --shape ring --agents "$n" --perturb 0.05 --seed 1 \
+      --steps "$steps" --name "ring$n" --out "$scenario" ${VF_BENCH_MAKE_FLAGS:-}
+  else
+    PYTHONPATH="$(dirname "${BASH_SOURCE[0]}")/../benchmark" python3 -c \
+      "import sys, simulate_scaling; sys.stdout.write(simulate_scaling.ring_yaml($n, $steps))" >"$scenario"
+  fi
   for m in "${modes[@]}"; do
     if [ -n "${skip[$m]:-}" ]; then
       row "$n" "$m" "$steps" n/a n/a n/a n/a n/a n/a
@@ -121,10 +163,12 @@ for n in "${counts[@]}"; do
     extra+=("${more[@]}")
     # No size limit: 600 steps of 1000 agents with their markers make about 1.8 GB.
     [ "$record" = 1 ] && extra+=(record:=true record_max_size:=0 output_dir:="$tmp/out_${m}_$n")
+    target=(variational_formation formation.launch)
+    [ "$m" = sharded ] && target=("$(sharded_launch "$scenario" "$n" "$tmp/sharded_$n")")
     launched=$EPOCHREALTIME
     ROS_MASTER_URI="http://localhost:$port" ROS_LOG_DIR="$tmp/ros_log" \
       timeout -s INT -k 30 "$timeout_s" \
-      roslaunch -p "$port" variational_formation formation.launch scenario:="$scenario" "${extra[@]}" \
+      roslaunch -p "$port" "${target[@]}" scenario:="$scenario" "${extra[@]}" \
       >"$log" 2>&1 &
     launch=$!
     sample_agents "$launch" "$log" "$samples" &
