@@ -35,7 +35,8 @@ vf_install_dependencies
 vf_build
 vf_source
 tmp="$(mktemp -d)"
-trap 'rm -rf "$tmp"' EXIT
+# VF_BENCH_KEEP=1 keeps the scenarios, launch logs and bags for a look afterwards.
+trap 'if [ "${VF_BENCH_KEEP:-0}" = 1 ]; then echo "benchmark_ros: kept $tmp" >&2; else rm -rf "$tmp"; fi' EXIT
 counts=("$@")
 [ ${#counts[@]} -eq 0 ] && counts=(6 20 50 100 200)
 read -r -a modes <<<"${VF_BENCH_MODES:-process nodelet}"
