@@ -29,7 +29,8 @@
 #   default 900), VF_BENCH_SAMPLE (s between samples, default 0.5), VF_BENCH_RECORD (1: record and
 #   check exactness; default 0), VF_BENCH_PORT_BASE and VF_BENCH_PORTS (the masters' port range,
 #   default 11500 and 100), VF_BENCH_MAKE_FLAGS (more make_scenario flags, e.g. "--safety 0.25 1 0.2"),
-#   VF_BENCH_ARGS (more formation.launch arguments, e.g. "rate:=1": a paced run).
+#   VF_BENCH_ARGS (more formation.launch arguments, e.g. "rate:=1": a paced run), VF_BENCH_KEEP (1: keep
+#   the temporary folder with the scenarios, launch logs and bags).
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 vf_install_dependencies
 vf_build
