@@ -83,7 +83,8 @@ int main(int argc, char** argv) {
     // one per core, as nodelet counts), not on nodelet's queue manager.
     const int threads = vf::optionalParam(pnh, "num_worker_threads", 0);
     if (threads < 0) throw vf::InvalidInput("~num_worker_threads: must be >= 0, got " + std::to_string(threads));
-    vf::AgentThreads::start(threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+    vf::AgentThreads::start(threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())),
+                            ids.size());
     struct EndThreads {
       ~EndThreads() { vf::AgentThreads::stop(); }  // after the loader unloaded the agents
     } endThreads;

@@ -138,13 +138,13 @@ bool AgentThreads::serves(const ros::CallbackQueueInterface* queue) { return que
 
 void AgentThreads::soon(std::function<void()> work) { tLane.push_back(std::move(work)); }
 
-void AgentThreads::start(int threads) { gThreads.reset(new AgentThreads(threads)); }
+void AgentThreads::start(int threads, std::size_t agents) { gThreads.reset(new AgentThreads(threads, agents)); }
 
 void AgentThreads::stop() { gThreads.reset(); }
 
 AgentThreads* AgentThreads::local() { return gThreads.get(); }
 
-AgentThreads::AgentThreads(int threads) {
+AgentThreads::AgentThreads(int threads, std::size_t agents) : agents_(agents) {
   for (int k = 0; k < std::max(1, threads); ++k) queues_.push_back(std::make_unique<ros::CallbackQueue>());
   for (auto& q : queues_) {
     threads_.emplace_back([this, queue = q.get()] {
@@ -175,7 +175,8 @@ void AgentThreads::halt() {
 
 ros::CallbackQueue* AgentThreads::nextQueue() {
   std::lock_guard<std::mutex> lock(mutex_);
-  return queues_[next_++ % queues_.size()].get();
+  const std::size_t k = next_++, t = queues_.size();
+  return queues_[k < agents_ ? k * t / agents_ : k % t].get();
 }
 
 std::vector<int> parseAgentIds(const std::string& list, const std::string& parameter) {

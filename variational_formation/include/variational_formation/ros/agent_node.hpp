@@ -7,13 +7,13 @@
 #include <vector>
 
 #include <ros/ros.h>
-#include <tf2_ros/transform_broadcaster.h>
 
 #include "variational_formation_msgs/AgentState.h"
 #include "variational_formation_msgs/FormationCommands.h"
 #include "variational_formation_msgs/RecallHistory.h"
 #include "variational_formation_msgs/RecallState.h"
 #include "variational_formation_msgs/RunProgress.h"
+#include "variational_formation/ros/frames.hpp"
 #include "variational_formation/ros/local_states.hpp"
 #include "variational_formation_core/protocol/topic_audience.hpp"
 #include "variational_formation/ros/periodic_call.hpp"
@@ -116,6 +116,10 @@ class AgentNode {
 
   ros::NodeHandle nh_;
   std::unique_ptr<Protocol> protocol_;
+  // Its own state messages, oldest first (makeState): the oldest, once nothing else holds it (its
+  // step is out of every history, queue and latch), is assigned over for the next state, its
+  // vectors keeping their memory, instead of freeing one message and allocating another.
+  mutable std::deque<AgentStatePtr> made_;
   ros::Publisher statePub_;
   LocalStates::Exchange* exchange_ = nullptr;  // the manager's, if it hosts this agent
   std::unique_ptr<TopicAudience<AgentState::ConstPtr>> audience_;  // with exchange_: who else needs the topic
@@ -128,7 +132,7 @@ class AgentNode {
   ros::Subscriber progressSub_, commandSub_;
   ros::ServiceServer recallServer_, historyServer_;
   std::string monitor_;
-  tf2_ros::TransformBroadcaster tf_;
+  FrameBroadcaster tf_{nh_};  // after nh_
   long pacedStep_ = -1;  // the step whose release by the Pacer it waits for (-1: none)
   double realTimeFactor_ = 0.0;
   ros::WallTime lastReportAt_;

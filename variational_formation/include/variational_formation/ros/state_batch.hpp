@@ -73,17 +73,21 @@ class StateBatch {
 };
 
 /**
- * The callback threads of an agent manager's own agents (doc/distributed.md, "Threads"): agent k
- * (in load order) runs its callbacks on queue k mod T, each served by a thread of its own, so a
- * state passes from one agent to the next with one hand-over between threads, where nodelet's
- * queue manager needs two (its manager thread, then a worker). One agent's callbacks stay on one
+ * The callback threads of an agent manager's own agents (doc/distributed.md, "Threads"): the
+ * manager's A agents, in load order, go to T queues in consecutive blocks (agent k to queue
+ * k T / A; agents loaded later, beyond A, to k mod T), each queue served by a thread of its own.
+ * Formations are numbered along their shape, so most neighbours share a thread and hand their
+ * states over through the inbox; a state that crosses passes with one hand-over between threads,
+ * where nodelet's queue manager needs two (its manager thread, then a worker). (Queue k mod T put
+ * a ring's next neighbours on the other thread: 2 of every agent's 4 states crossed, at 100
+ * agents a third of the manager's time in the queues' locks, wake-ups and allocations.) One agent's callbacks stay on one
  * thread, one at a time, as in a node. One per process, started by agent_manager; agents loaded
  * in any other manager keep nodelet's queues.
  */
 class AgentThreads {
  public:
-  /// Starts `threads` (>= 1) queues and threads for this process.
-  static void start(int threads);
+  /// Starts `threads` (>= 1) queues and threads for this process, for `agents` agents to load.
+  static void start(int threads, std::size_t agents);
   /// Destroys this process's threads and queues (halting them first).
   static void stop();
   /// Joins the threads and disables the queues: no agent callback runs afterwards, and a callback
@@ -105,11 +109,12 @@ class AgentThreads {
   ~AgentThreads();
 
  private:
-  explicit AgentThreads(int threads);
+  AgentThreads(int threads, std::size_t agents);
 
   std::vector<std::unique_ptr<ros::CallbackQueue>> queues_;
   std::vector<std::thread> threads_;
-  std::size_t next_ = 0;  // guarded by mutex_
+  std::size_t agents_ = 0;  // agents to load, in blocks
+  std::size_t next_ = 0;    // guarded by mutex_
   std::mutex mutex_;
   std::atomic<bool> stopping_{false};
 };
