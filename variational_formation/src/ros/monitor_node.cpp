@@ -199,6 +199,7 @@ int MonitorNode::run() {
   progressPub_.publish(progress_);
   watchTimer_ = nh_.createWallTimer(ros::WallDuration(0.5), [this](const ros::WallTimerEvent&) {
     if (!ended()) watch();
+    if (publishClock_) publishClock();  // one held back while steps came faster than kClockPeriod
   });
   auto* queue = ros::getGlobalCallbackQueue();
   while (ros::ok() && !ended()) queue->callAvailable(ros::WallDuration(0.1));

@@ -41,19 +41,17 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
   }
   statusPub_.publish(status);
   goals_->onStep(s.metrics.step, s.positions, s.converged, s.metrics.maxDistanceError, stamp);
-  // Never backwards: with several formations on one master, the one furthest ahead sets it.
-  if (publishClock_ && (!ros::Time::isSimTime() || stamp >= ros::Time::now())) {
-    rosgraph_msgs::Clock clock;
-    clock.clock = stamp;
-    clockPub_.publish(clock);
+  const long step = s.metrics.step, last = scenario_.steps;
+  const bool edge = step == 0 || (last > 0 && step == last);
+  if (publishClock_) {
+    clockDue_ = stamp;
+    if (edge || (now - clockAt_).toSec() >= kClockPeriod) publishClock();
   }
   // Markers cost O(n + |E|) per step (trails thinned to a bound, Trails): built only when someone
   // takes them (the recorder, a viewer), every marker_every steps, and always at the first and
   // last step so that the latched one is right. The trails above still get every step. The
   // trails and the ghost, most of an array's bytes, come every allMarkersEvery_ steps only (and
   // at the first and last step): rviz keeps the last ones it got.
-  const long step = s.metrics.step, last = scenario_.steps;
-  const bool edge = step == 0 || (last > 0 && step == last);
   if (edge || (step % markerEvery_ == 0 && (recording_ || markersPub_.getNumSubscribers() > 0))) {
     const bool all = edge || allMarkersStep_ < 0 || step < allMarkersStep_ || step - allMarkersStep_ >= allMarkersEvery_;
     if (all) allMarkersStep_ = step;
@@ -78,6 +76,17 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
   }
   if (blocked) report(protocol::Blocked{});  // the formation cannot form: say so instead of running on
   return out;
+}
+
+void MonitorNode::publishClock() {
+  if (clockDue_.isZero() || clockDue_ == clockSent_) return;
+  clockAt_ = ros::WallTime::now();
+  clockSent_ = clockDue_;
+  // Never backwards: with several formations on one master, the one furthest ahead sets it.
+  if (ros::Time::isSimTime() && clockDue_ < ros::Time::now()) return;
+  rosgraph_msgs::Clock clock;
+  clock.clock = clockDue_;
+  clockPub_.publish(clock);
 }
 
 void MonitorNode::writeResult(const std::string& result, const std::string& reason) const {

@@ -21,6 +21,7 @@ import unittest
 import rosgraph
 import rospy
 import rostest
+from rosgraph_msgs.msg import Clock
 from variational_formation_msgs.msg import FormationStatus
 from visualization_msgs.msg import MarkerArray
 
@@ -49,6 +50,13 @@ class DistributedRun(unittest.TestCase, vf_rostest.RunChecks):
                 cls.arrivals.append((time.monotonic(), msg.step))
 
         cls.sub = rospy.Subscriber("/formation/status", FormationStatus, on_status, queue_size=100000)
+        cls.clocks = []  # (wall time, simulated time) of the monitor's /clock messages
+
+        def on_clock(msg):
+            with lock:
+                cls.clocks.append((time.monotonic(), msg.clock.to_sec()))
+
+        cls.clock_sub = rospy.Subscriber("/clock", Clock, on_clock, queue_size=100000)
         name = os.path.basename(cls.path).replace(".yaml", "")
         # Until the run is over: who subscribed to what while it ran (the master's view).
         # The run waits for a viewer (distributed_run.test sets wait_for_viewer): this test becomes
@@ -135,6 +143,25 @@ class DistributedRun(unittest.TestCase, vf_rostest.RunChecks):
         due = (k1 - k0) * float(self.scenario["time_step"]) / self.rate
         self.assertGreater(t1 - t0, 0.95 * due)
         self.assertLess(t1 - t0, 1.5 * due + 1.0)
+
+    def test_clock_follows_the_steps_at_most_100_hz(self):
+        # The monitor sends /clock at the first and last step and at most every 10 ms of wall time
+        # between (MonitorNode::kClockPeriod), never backwards, always a completed step's time.
+        h, last = float(self.scenario["time_step"]), int(self.scenario["steps"])
+        end = time.time() + 5.0
+        while (not self.clocks or abs(self.clocks[-1][1] - last * h) > 1e-6) and time.time() < end:
+            time.sleep(0.05)
+        self.assertTrue(self.clocks, "no /clock message reached the test")
+        times = [c for _, c in self.clocks]
+        self.assertAlmostEqual(times[-1], last * h, delta=1e-6, msg="the last /clock is not the last step's time")
+        for a, b in zip(times, times[1:]):
+            self.assertLessEqual(a, b, "/clock went backwards")
+        for c in times:
+            self.assertAlmostEqual(round(c / h) * h, c, delta=1e-6, msg=f"/clock {c} is not a step's time")
+        # At most one per 10 ms, plus the last step's; 50 % for delivery jitter.
+        span = self.clocks[-1][0] - self.clocks[0][0]
+        self.assertLessEqual(len(times), 1.5 * 100 * span + 5,
+                             f"{len(times)} /clock messages in {span:.3f} s of wall time ({last} steps)")
 
     def test_states_come_batched_from_a_manager(self):
         if not self.nodelet:

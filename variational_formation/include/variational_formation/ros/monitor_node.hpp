@@ -128,6 +128,8 @@ class MonitorNode {
   void setUpParameters(ros::NodeHandle& nh, bool timed);
   void onReconfigure(variational_formation::FormationConfig& config, uint32_t level);
 
+  /// /clock at the newest completed step's time, if not sent yet (and not behind another formation's).
+  void publishClock();
   /// Publishes one completed step's status and markers (and /clock), stamped `stamp`; tracks the
   /// congruent stretch for the result; reports a formation it finds blocked (report(Blocked)).
   /// @return what was published, for the recorder gate.
@@ -225,6 +227,14 @@ class MonitorNode {
   std::vector<BatchSource> batches_;  // managers whose agents come batched (doc/distributed.md, "Batches")
   ros::Publisher clockPub_;
   bool publishClock_ = false;  // ~publish_clock (lockstep): /clock follows the completed steps, never backwards
+  // /clock goes out at the first and the last step and at most every kClockPeriod of wall time
+  // between (100 Hz, as `rosbag play` publishes it), with the newest completed step's time; the
+  // watch timer sends one held back when the run pauses. Every step's /clock went to every node
+  // of the run (they all subscribe under /use_sim_time): at 100 agents it cost a quarter of the
+  // throughput (doc/benchmarks.md).
+  static constexpr double kClockPeriod = 0.01;  // [s] of wall time
+  ros::Time clockDue_, clockSent_;  // the newest completed step's time; the last one sent
+  ros::WallTime clockAt_;           // when the last one was sent
   ros::WallTimer watchTimer_;
   Trails trails_{1, 2};  // replaced once the scenario is read
   int trailLength_ = 100;
