@@ -4,6 +4,7 @@ add_library(variational_formation_ros
   src/ros/agent_node.cpp
   src/ros/agent_recovery.cpp
   src/ros/formation_subscriptions.cpp
+  src/ros/frame_broadcaster.cpp
   src/ros/frames.cpp
   src/ros/liveness.cpp
   src/ros/local_states.cpp

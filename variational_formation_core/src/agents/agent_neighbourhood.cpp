@@ -24,7 +24,6 @@ AgentNeighbourhood::AgentNeighbourhood(const Scenario& scenario, int id, std::sh
   q0_.assign(scenario.initialPositions.col(id).data(), scenario.initialPositions.col(id).data() + d);
   v0_.assign(scenario.initialVelocities.col(id).data(), scenario.initialVelocities.col(id).data() + d);
   for (const Neighbour& nb : formation.neighbours(id)) neighbourIds_.push_back(nb.agent);
-  view_ = Positions::Zero(d, n);
   motion_ = motionParameters(formation, id);
 }
 

@@ -1,5 +1,6 @@
 #include "variational_formation_core/agents/lockstep_agent.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "variational_formation_core/common/invalid_input.hpp"
@@ -22,7 +23,11 @@ LockstepAgent::LockstepAgent(std::shared_ptr<const Scenario> shared, std::shared
   q_ = neighbourhood_.initialPosition();
   qPrev_ = q_;
   qBeforePrev_ = q_;
-  neighbours_.resize(static_cast<std::size_t>(scenario.agentCount()));
+  const std::vector<int>& ids = neighbourhood_.neighbourIds();
+  neighbours_.resize(ids.size());
+  for (std::size_t k = 0; k < ids.size(); ++k) slots_.emplace_back(ids[k], static_cast<int>(k));
+  std::sort(slots_.begin(), slots_.end());
+  spare_.assign(static_cast<std::size_t>(dimension_), 0.0);
   if (!scenario.manoeuvre.empty()) {
     manoeuvre_ = std::make_unique<ManoeuvreModel>(coefficients_,
                                                   scheduleFromSegments(scenario.manoeuvre, scenario.timeStep));
@@ -38,11 +43,10 @@ LockstepAgent::LockstepAgent(std::shared_ptr<const Scenario> shared, std::shared
   }
 }
 
-bool LockstepAgent::isNeighbour(long j) const {
-  for (int k : neighbourIds()) {
-    if (k == j) return true;
-  }
-  return false;
+const LockstepAgent::NeighbourState* LockstepAgent::held(long j) const {
+  const auto it = std::lower_bound(slots_.begin(), slots_.end(), j,
+                                   [](const std::pair<int, int>& s, long id) { return s.first < id; });
+  return it != slots_.end() && it->first == j ? &neighbours_[static_cast<std::size_t>(it->second)] : nullptr;
 }
 
 void LockstepAgent::offerOwn() {
@@ -110,14 +114,14 @@ LockstepAgent::Receipt LockstepAgent::receive(long sender, long step,
     case AgentNeighbourhood::StateCheck::NonFinite: return Receipt::NonFinite;
     case AgentNeighbourhood::StateCheck::Usable: break;
   }
-  NeighbourState& held = neighbours_[static_cast<std::size_t>(sender)];
+  NeighbourState& state = *held(sender);  // check() accepts neighbours only
   // A neighbour is at most one step ahead, and never goes back.
   if (step < 0 || step > step_ + 1) return Receipt::ImpossibleStep;
-  if (step == held.step) return Receipt::Duplicate;
-  if (step < held.step) return Receipt::ImpossibleStep;
-  held.step = step;
-  held.position = position;
-  held.previousPosition = previousPosition;
+  if (step == state.step) return Receipt::Duplicate;
+  if (step < state.step) return Receipt::ImpossibleStep;
+  state.step = step;
+  state.position = position;
+  state.previousPosition = previousPosition;
   if (board_) board_->offer(sender, step, position.data(), previousPosition.data());
   return Receipt::Accepted;
 }
@@ -129,16 +133,17 @@ const double* LockstepAgent::neighbourPositionAtStep(const NeighbourState& s) co
 }
 
 bool LockstepAgent::holdsNeighbourStep(int j) const {
-  return j >= 0 && j < static_cast<int>(neighbours_.size()) &&
-         neighbourPositionAtStep(neighbours_[static_cast<std::size_t>(j)]) != nullptr;
+  const NeighbourState* s = held(j);
+  return s && neighbourPositionAtStep(*s) != nullptr;
 }
 
 bool LockstepAgent::neighbourState(int j, long& step, std::vector<double>& position,
                                    std::vector<double>& previousPosition) const {
-  if (j < 0 || j >= static_cast<int>(neighbours_.size())) return false;
-  if (board_ && j != id_ && !isNeighbour(j)) return board_->newest(j, step, position, previousPosition);
-  const NeighbourState& s = neighbours_[static_cast<std::size_t>(j)];
-  if (s.step < 0) return false;
+  if (j < 0 || j >= scenario_->agentCount()) return false;
+  const NeighbourState* held = this->held(j);
+  if (board_ && j != id_ && !held) return board_->newest(j, step, position, previousPosition);
+  if (!held || held->step < 0) return false;
+  const NeighbourState& s = *held;
   step = s.step;
   position = s.position;
   previousPosition = s.previousPosition;
@@ -146,8 +151,8 @@ bool LockstepAgent::neighbourState(int j, long& step, std::vector<double>& posit
 }
 
 bool LockstepAgent::ready() const {
-  for (int j : neighbourIds()) {
-    if (!neighbourPositionAtStep(neighbours_[static_cast<std::size_t>(j)])) return false;
+  for (const NeighbourState& s : neighbours_) {
+    if (!neighbourPositionAtStep(s)) return false;
   }
   return !board_ || board_->complete(step_);
 }
@@ -168,18 +173,18 @@ void LockstepAgent::filter(double* next) {
 
 void LockstepAgent::advance() {
   if (!ready()) throw InvalidInput("advance: a neighbour's state at step " + std::to_string(step_) + " is missing");
-  std::vector<double> next(static_cast<std::size_t>(dimension_));
+  std::vector<double>& next = spare_;  // d doubles, no allocation per step
   if (manoeuvre_) {
     manoeuvreStep(next.data());
   } else {
     double gradient[3];
     neighbourhood_.gradient(
-        q_.data(), [this](int j) { return neighbourPositionAtStep(neighbours_[static_cast<std::size_t>(j)]); },
-        gradient);
+        q_.data(), [this](int j) { return neighbourPositionAtStep(*held(j)); }, gradient);
     variationalStep(coefficients_, start_, step_, dimension_, qPrev_.data(), q_.data(),
                     neighbourhood_.initialVelocity().data(), gradient, next.data());
   }
   filter(next.data());
+  // q_{k-1} -> q_{k-2}, q_k -> q_{k-1}, next -> q_k; the old q_{k-2}'s memory becomes the spare.
   qBeforePrev_.swap(qPrev_);
   qPrev_.swap(q_);
   q_.swap(next);
@@ -193,8 +198,8 @@ void LockstepAgent::manoeuvreStep(double* next) {
   const ManoeuvreGains g = manoeuvre_->updateGains(step_);
   double gradient[3], offset[3] = {0.0, 0.0, 0.0};
   neighbourhood_.forcedGradient(
-      q_.data(), [this](int j) { return neighbourPositionAtStep(neighbours_[static_cast<std::size_t>(j)]); },
-      g.scaleSquared, g.rotates, gradient, offset);
+      q_.data(), [this](int j) { return neighbourPositionAtStep(*held(j)); }, g.scaleSquared, g.rotates, gradient,
+      offset);
   if (step_ > 0) {
     manoeuvreUpdate(coefficients_, g, dimension_, qPrev_.data(), q_.data(), gradient, offset, next);
   } else if (start_ == StartMethod::Variational) {

@@ -11,19 +11,6 @@
 
 namespace vf {
 
-namespace {
-// Squared distance and difference of two columns, coordinate by coordinate so that every
-// caller sums in the same order whatever the memory alignment.
-double squaredDistance(const double* a, const double* b, int d) {
-  double s = 0.0;
-  for (int c = 0; c < d; ++c) {
-    const double diff = a[c] - b[c];
-    s += diff * diff;
-  }
-  return s;
-}
-}  // namespace
-
 int rigidEdgeCount(int dimension, int agentCount) {
   return dimension * agentCount - dimension * (dimension + 1) / 2;
 }
@@ -95,24 +82,12 @@ double Formation::agentPotential(int agent, const Positions& q, double scaleSqua
 
 // doc/maths.md §1, gradient; paper Section 6 per-agent formula with Gamma_ij = |q_i - q_j|^2 - d_ij^2.
 void Formation::agentGradient(int agent, const Positions& q, double* out) const {
-  const double* qi = q.col(agent).data();
-  for (int c = 0; c < dimension_; ++c) out[c] = 0.0;
-  for (const Neighbour& nb : neighbours_[agent]) {
-    const double* qj = q.col(nb.agent).data();
-    const double gamma = squaredDistance(qi, qj, dimension_) - nb.desiredDistanceSquared;
-    for (int c = 0; c < dimension_; ++c) out[c] += gamma * (qi[c] - qj[c]);
-  }
+  agentGradientFrom(agent, q.col(agent).data(), [&q](int j) { return q.col(j).data(); }, out);
 }
 
 void Formation::agentScaledGradient(int agent, const Positions& q, double scaleSquared,
                                     double* out) const {
-  const double* qi = q.col(agent).data();
-  for (int c = 0; c < dimension_; ++c) out[c] = 0.0;
-  for (const Neighbour& nb : neighbours_[agent]) {
-    const double* qj = q.col(nb.agent).data();
-    const double gamma = squaredDistance(qi, qj, dimension_) - scaleSquared * nb.desiredDistanceSquared;
-    for (int c = 0; c < dimension_; ++c) out[c] += gamma * (qi[c] - qj[c]);
-  }
+  agentScaledGradientFrom(agent, q.col(agent).data(), [&q](int j) { return q.col(j).data(); }, scaleSquared, out);
 }
 
 double Formation::scaledPotential(const Positions& q, double scaleSquared) const {

@@ -46,15 +46,7 @@ MotionParameters motionParameters(const Formation& formation, int agent) {
 
 void centroidOffset(const Formation& formation, const MotionParameters& parameters, int agent,
                     const Positions& q, double* out) {
-  const int d = formation.dimension();
-  const double* qi = q.col(agent).data();
-  for (int a = 0; a < d; ++a) out[a] = 0.0;
-  const std::vector<Neighbour>& nbs = formation.neighbours(agent);
-  for (std::size_t e = 0; e < nbs.size(); ++e) {
-    const double* qj = q.col(nbs[e].agent).data();
-    const double mu = parameters.weights[e];
-    for (int a = 0; a < d; ++a) out[a] += mu * (qi[a] - qj[a]);
-  }
+  centroidOffsetFrom(formation, parameters, agent, q.col(agent).data(), [&q](int j) { return q.col(j).data(); }, out);
 }
 
 }  // namespace vf

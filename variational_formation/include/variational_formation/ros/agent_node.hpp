@@ -13,7 +13,7 @@
 #include "variational_formation_msgs/RecallHistory.h"
 #include "variational_formation_msgs/RecallState.h"
 #include "variational_formation_msgs/RunProgress.h"
-#include "variational_formation/ros/frames.hpp"
+#include "variational_formation/ros/frame_broadcaster.hpp"
 #include "variational_formation/ros/local_states.hpp"
 #include "variational_formation_core/protocol/topic_audience.hpp"
 #include "variational_formation/ros/periodic_call.hpp"

@@ -48,6 +48,10 @@ class AgentNeighbourhood {
    */
   template <class NeighbourPosition>
   void gradient(const double* own, NeighbourPosition neighbourPosition, double* out) {
+    if (model_.terms().empty()) {  // V alone reads only N_i: straight from the held positions
+      model_.formation().agentGradientFrom(id_, own, neighbourPosition, out);
+      return;
+    }
     view(own, neighbourPosition);
     model_.agentGradient(id_, view_, out);
   }
@@ -60,6 +64,11 @@ class AgentNeighbourhood {
   template <class NeighbourPosition>
   void forcedGradient(const double* own, NeighbourPosition neighbourPosition, double scaleSquared, bool rotates,
                       double* gradient, double* offset) {
+    if (model_.terms().empty()) {
+      model_.formation().agentScaledGradientFrom(id_, own, neighbourPosition, scaleSquared, gradient);
+      if (rotates) centroidOffsetFrom(model_.formation(), motion_, id_, own, neighbourPosition, offset);
+      return;
+    }
     view(own, neighbourPosition);
     model_.agentGradient(id_, view_, scaleSquared, gradient);
     if (rotates) model_.centroidOffset(motion_, id_, view_, offset);
@@ -69,10 +78,12 @@ class AgentNeighbourhood {
   const MotionParameters& motion() const { return motion_; }
 
  private:
-  /// The agent's and its neighbours' positions into view_.
+  /// The agent's and its neighbours' positions into view_ (made at the first call: only a model
+  /// with added terms, which may read any column, needs it).
   template <class NeighbourPosition>
   void view(const double* own, NeighbourPosition neighbourPosition) {
     const int d = dimension();
+    if (view_.cols() == 0) view_ = Positions::Zero(d, model_.agentCount());
     for (int a = 0; a < d; ++a) view_(a, id_) = own[a];
     for (int j : neighbourIds_) {
       const double* qj = neighbourPosition(j);
@@ -84,7 +95,7 @@ class AgentNeighbourhood {
   int id_;
   std::vector<int> neighbourIds_;
   std::vector<double> q0_, v0_;
-  Positions view_;  // positions of self and neighbours, d x n (other columns unused)
+  Positions view_;  // with added terms: positions of self and neighbours, d x n (other columns unused)
   MotionParameters motion_;
 };
 

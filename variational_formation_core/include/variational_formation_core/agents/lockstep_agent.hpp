@@ -2,6 +2,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "variational_formation_core/manoeuvres/manoeuvre_model.hpp"
@@ -125,7 +126,10 @@ class LockstepAgent {
   void manoeuvreStep(double* next);
   /// Neighbour's q_k if held, else nullptr.
   const double* neighbourPositionAtStep(const NeighbourState& s) const;
-  bool isNeighbour(long j) const;
+  bool isNeighbour(long j) const { return held(j) != nullptr; }
+  /// Neighbour j's held state; nullptr if j is not a neighbour.
+  const NeighbourState* held(long j) const;
+  NeighbourState* held(long j) { return const_cast<NeighbourState*>(static_cast<const LockstepAgent*>(this)->held(j)); }
   /// Filters q_{k+1} (`next`) with the agents the board senses at k (doc/maths.md §10).
   void filter(double* next);
   /// Puts its own q_k on the board.
@@ -142,7 +146,11 @@ class LockstepAgent {
   long step_ = 0;
   bool advanced_ = false;  // advance() ran since the start or the last resume()
   std::vector<double> qPrev_, q_, qBeforePrev_;
-  std::vector<NeighbourState> neighbours_;  // indexed by agent id (only neighbours used)
+  std::vector<NeighbourState> neighbours_;  // one per neighbour, in neighbourIds() order
+  // (agent id, index in neighbours_), by id: a neighbour's state in O(log |N_i|), with memory
+  // per agent that grows with its neighbours, not with the formation.
+  std::vector<std::pair<int, int>> slots_;
+  std::vector<double> spare_;  // d doubles: the next position is computed here, then rotated in
   // Set once the agent has a command (the scenario's manoeuvre, or a received one); until then
   // advance() runs today's update unchanged.
   std::unique_ptr<ManoeuvreModel> manoeuvre_;

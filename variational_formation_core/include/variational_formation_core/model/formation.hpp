@@ -59,10 +59,44 @@ class Formation {
    */
   void agentGradient(int agent, const Positions& q, double* out) const;
   /**
+   * agentGradient with q_i at `qi` and q_j at column(j) (d doubles each, j in N_i): the very
+   * operations in the same order, for an agent that holds only its neighbours' positions (a
+   * d x n matrix per agent would make a formation's memory grow as n^2).
+   */
+  template <class Column>
+  void agentGradientFrom(int agent, const double* qi, Column column, double* out) const {
+    for (int c = 0; c < dimension_; ++c) out[c] = 0.0;
+    for (const Neighbour& nb : neighbours_[agent]) {
+      const double* qj = column(nb.agent);
+      const double gamma = squaredDistance(qi, qj, dimension_) - nb.desiredDistanceSquared;
+      for (int c = 0; c < dimension_; ++c) out[c] += gamma * (qi[c] - qj[c]);
+    }
+  }
+  /**
    * grad_i V_s for the scaled distances s d_ij (doc/maths.md §9): gamma_ij = |q_i - q_j|^2 - s^2 d_ij^2.
    * @param scaleSquared s^2 [1]. Same reads and order as agentGradient.
    */
   void agentScaledGradient(int agent, const Positions& q, double scaleSquared, double* out) const;
+  /// agentScaledGradient with q_i at `qi` and q_j at column(j), as agentGradientFrom.
+  template <class Column>
+  void agentScaledGradientFrom(int agent, const double* qi, Column column, double scaleSquared, double* out) const {
+    for (int c = 0; c < dimension_; ++c) out[c] = 0.0;
+    for (const Neighbour& nb : neighbours_[agent]) {
+      const double* qj = column(nb.agent);
+      const double gamma = squaredDistance(qi, qj, dimension_) - scaleSquared * nb.desiredDistanceSquared;
+      for (int c = 0; c < dimension_; ++c) out[c] += gamma * (qi[c] - qj[c]);
+    }
+  }
+  /// |a - b|^2 of d coordinates, coordinate by coordinate, so that every caller sums in the same
+  /// order whatever the memory alignment.
+  static double squaredDistance(const double* a, const double* b, int d) {
+    double s = 0.0;
+    for (int c = 0; c < d; ++c) {
+      const double diff = a[c] - b[c];
+      s += diff * diff;
+    }
+    return s;
+  }
   /// V_s(q) for the scaled distances s d_ij, @param scaleSquared s^2.
   double scaledPotential(const Positions& q, double scaleSquared) const;
   /// Stacked gradient, d x n, agent by agent through agentGradient.

@@ -39,4 +39,19 @@ MotionParameters motionParameters(const Formation& formation, int agent);
 void centroidOffset(const Formation& formation, const MotionParameters& parameters, int agent,
                     const Positions& q, double* out);
 
+/// centroidOffset with q_i at `qi` and q_j at column(j) (d doubles each, j in N_i): the same
+/// operations in the same order, without a d x n matrix.
+template <class Column>
+void centroidOffsetFrom(const Formation& formation, const MotionParameters& parameters, int agent, const double* qi,
+                        Column column, double* out) {
+  const int d = formation.dimension();
+  for (int a = 0; a < d; ++a) out[a] = 0.0;
+  const std::vector<Neighbour>& nbs = formation.neighbours(agent);
+  for (std::size_t e = 0; e < nbs.size(); ++e) {
+    const double* qj = column(nbs[e].agent);
+    const double mu = parameters.weights[e];
+    for (int a = 0; a < d; ++a) out[a] += mu * (qi[a] - qj[a]);
+  }
+}
+
 }  // namespace vf
