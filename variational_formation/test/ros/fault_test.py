@@ -34,6 +34,7 @@ import rosbag
 import rospy
 import rostest
 from variational_formation_msgs.msg import AgentState, FormationStatus
+from variational_formation_msgs.srv import RecallHistory
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import vf_rostest  # noqa: E402
@@ -171,10 +172,18 @@ class FaultRun(unittest.TestCase, vf_rostest.RunChecks):
                       ", ".join(holders), victim, before)
         cls.injected.append((step, [f"{NS}/agent_{victim}"]))
         # The respawned agent's recall gets no answer within its 2 s: it starts from the scenario.
-        end = time.time() + 30
-        while cls.watch.last[victim] != 0 and time.time() < end:
-            time.sleep(0.01)
-        started = cls.watch.last[victim] == 0
+        # The test may not see its step 0 on the topic: the master tells a topic's subscribers of
+        # a new publisher from a few worker threads, which its calls to the stopped holders block.
+        # So it also asks the agent's own ~history, a call that needs no such notice.
+        history = rospy.ServiceProxy(f"{NS}/agent_{victim}/history", RecallHistory)
+        end, started = time.time() + 30, False
+        while not started and time.time() < end:
+            started = cls.watch.last[victim] == 0
+            try:
+                started = started or any(s.step == 0 for s in history(victim).states)
+            except (rospy.ServiceException, rospy.ROSException, OSError):
+                pass  # the new incarnation does not serve yet (the dead one may still be registered)
+            time.sleep(0.05)
         for pid in stopped:
             os.kill(pid, signal.SIGCONT)
         assert started, f"the respawned agent_{victim} never published step 0 (its last state: {cls.watch.last[victim]})"
