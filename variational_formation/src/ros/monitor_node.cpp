@@ -70,11 +70,9 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh, bool timed) 
     for (int id : batches_[m].ids) batched[static_cast<std::size_t>(id)] = true;
     // As deep as the agents' own topics together: a batch may hold a single state.
     const uint32_t depth = static_cast<uint32_t>((2 * window_ + 10) * static_cast<long>(batches_[m].ids.size()));
-    subs_.push_back(nh.subscribe<variational_formation_msgs::AgentStates>(
-        batches_[m].manager + "/states", depth,
-        boost::function<void(const ros::MessageEvent<variational_formation_msgs::AgentStates const>&)>(
-            [this, m](const ros::MessageEvent<variational_formation_msgs::AgentStates const>& e) { onBatch(m, e); }),
-        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
+    subs_.push_back(subscribeToBatches(
+        nh, batches_[m].manager + "/states", depth,
+        [this, m](const ros::MessageEvent<variational_formation_msgs::AgentStates const>& e) { onBatch(m, e); }));
   }
   for (int i = 0; i < n; ++i) {
     agents_.push_back({agentNodeName(nh, i), false, ros::WallTime(), ""});

@@ -54,11 +54,9 @@ RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) 
   std::vector<bool> batched(static_cast<std::size_t>(n), false);
   for (std::size_t m = 0; m < batches_.size(); ++m) {
     for (int id : batches_[m].ids) batched[static_cast<std::size_t>(id)] = true;
-    subs_.push_back(nh.subscribe<variational_formation_msgs::AgentStates>(
-        batches_[m].manager + "/states", kQueue,
-        boost::function<void(const ros::MessageEvent<variational_formation_msgs::AgentStates const>&)>(
-            [this, m](const ros::MessageEvent<variational_formation_msgs::AgentStates const>& e) { onBatch(m, e); }),
-        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
+    subs_.push_back(subscribeToBatches(
+        nh, batches_[m].manager + "/states", kQueue,
+        [this, m](const ros::MessageEvent<variational_formation_msgs::AgentStates const>& e) { onBatch(m, e); }));
   }
   for (int i = 0; i < n; ++i) {
     owners_.push_back(agentNodeName(nh, i));

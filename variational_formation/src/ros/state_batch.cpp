@@ -199,6 +199,40 @@ std::vector<int> parseAgentIds(const std::string& list, const std::string& param
   return ids;
 }
 
+namespace {
+/// Hands roscpp a message to read a batch into: one that nothing holds any more (roscpp and the
+/// callbacks let go of it: its use count is 1), or a new one; at most kKept kept.
+class RecycledBatches {
+ public:
+  variational_formation_msgs::AgentStatesPtr operator()() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (auto& held : kept_) {
+      if (held.use_count() == 1) return held;
+    }
+    auto fresh = boost::make_shared<variational_formation_msgs::AgentStates>();
+    if (kept_.size() < kKept) kept_.push_back(fresh);
+    return fresh;
+  }
+
+ private:
+  static constexpr std::size_t kKept = 16;
+  std::mutex mutex_;
+  std::vector<variational_formation_msgs::AgentStatesPtr> kept_;
+};
+}  // namespace
+
+ros::Subscriber subscribeToBatches(
+    ros::NodeHandle& nh, const std::string& topic, uint32_t depth,
+    const std::function<void(const ros::MessageEvent<variational_formation_msgs::AgentStates const>&)>& callback) {
+  using Event = const ros::MessageEvent<variational_formation_msgs::AgentStates const>&;
+  auto recycled = std::make_shared<RecycledBatches>();
+  ros::SubscribeOptions options;
+  options.initByFullCallbackType<Event>(topic, depth, boost::function<void(Event)>(callback),
+                                        [recycled] { return (*recycled)(); });
+  options.transport_hints = ros::TransportHints().tcpNoDelay();
+  return nh.subscribe(options);
+}
+
 std::vector<BatchSource> batchSources(const ros::NodeHandle& nh, const std::vector<std::string>& managers, int agents) {
   std::vector<BatchSource> sources;
   std::map<int, int> claims;

@@ -99,16 +99,19 @@ TEST(ShapeTracker, AgreesWithTheMonitorOnTheShippedHexagon) {
   EXPECT_LT(o.findings.shapeError, 0.01 * 3.0);
 }
 
-TEST(ShapeOutcome, TheAllPairsErrorCostsAtMostTwoHundredAgentsPerStep) {
-  for (long k = 0; k < 50; ++k) EXPECT_TRUE(shapeErrorMeasuredAt(k, 200, 0));
-  // 1000 agents: (1000/200)^2 = 25 times the pairs, measured every 25th step and at the last.
+TEST(ShapeOutcome, TheAllPairsErrorCostsAtMostFiftyAgentsPerStep) {
+  for (long k = 0; k < 50; ++k) EXPECT_TRUE(shapeErrorMeasuredAt(k, 50, 0));
+  // 250 agents: (250/50)^2 = 25 times the pairs, measured every 25th step and at the last.
   int measured = 0;
-  for (long k = 0; k <= 1000; ++k) measured += shapeErrorMeasuredAt(k, 1000, 990) ? 1 : 0;
+  for (long k = 0; k <= 1000; ++k) measured += shapeErrorMeasuredAt(k, 250, 990) ? 1 : 0;
   EXPECT_EQ(measured, 41 + 1);  // 0, 25, ..., 1000, and 990
-  EXPECT_TRUE(shapeErrorMeasuredAt(990, 1000, 990));
-  EXPECT_FALSE(shapeErrorMeasuredAt(991, 1000, 990));
-  EXPECT_TRUE(shapeErrorMeasuredAt(50, 201, 0));  // ceil(1.01^2) = 2
-  EXPECT_FALSE(shapeErrorMeasuredAt(51, 201, 0));
+  EXPECT_TRUE(shapeErrorMeasuredAt(990, 250, 990));
+  EXPECT_FALSE(shapeErrorMeasuredAt(991, 250, 990));
+  EXPECT_TRUE(shapeErrorMeasuredAt(50, 51, 0));  // ceil(1.02^2) = 2
+  EXPECT_FALSE(shapeErrorMeasuredAt(51, 51, 0));
+  // 200 agents: 16 times the pairs of 50, every 16th step.
+  EXPECT_TRUE(shapeErrorMeasuredAt(32, 200, 0));
+  EXPECT_FALSE(shapeErrorMeasuredAt(33, 200, 0));
 }
 
 }  // namespace

@@ -118,7 +118,7 @@ FormationSnapshot FormationMonitor::measureStep(long step, const Positions& qPre
   s.positions = q;
   subtractCommandedMotion(command, q, v);  // from here on, relative to the commanded motion
   s.converged = congruence_.check(formation_, q, v, scale);
-  // The O(n^2) shape error at most a 200-agent cost per step (NaN between).
+  // The O(n^2) shape error at most a 50-agent cost per step (NaN between).
   const bool measured = shapeErrorMeasuredAt(step, formation_.agentCount(), scenario_.steps);
   s.shape = findShape(formation_, q, v, scale, s.converged, tolerance_, maxSpeed_, measured);
   if (!s.converged) {

@@ -30,7 +30,7 @@ ShapeOutcome blockedShapeOutcome(ShapeOutcome outcome, const std::string& blocke
 }
 
 bool shapeErrorMeasuredAt(long step, int agents, long lastStep) {
-  const long every = static_cast<long>(std::ceil(std::pow(agents / 200.0, 2)));
+  const long every = static_cast<long>(std::ceil(std::pow(agents / 50.0, 2)));
   return every <= 1 || step % every == 0 || (lastStep > 0 && step == lastStep);
 }
 
