@@ -197,7 +197,7 @@ void AgentNode::publish(const AgentState::ConstPtr& state) {
     if (audience_->published(state)) statePub_.publish(state);
   }
   if (StateBatch* batch = StateBatch::local()) batch->add(state);  // in an agent_manager
-  if (tf_.heard()) tf_.send(frameAt(state->header, frame_, state->position));
+  tf_.send(state->header, frame_, state->position);
 }
 
 void AgentNode::reportWaiting() {

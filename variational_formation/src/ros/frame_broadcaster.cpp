@@ -2,6 +2,8 @@
 
 #include <tf2_msgs/TFMessage.h>
 
+#include "variational_formation/ros/frames.hpp"
+
 namespace vf {
 
 FrameBroadcaster::FrameBroadcaster(ros::NodeHandle& nh) {
@@ -11,10 +13,11 @@ FrameBroadcaster::FrameBroadcaster(ros::NodeHandle& nh) {
       [listeners](const ros::SingleSubscriberPublisher&) { --*listeners; });
 }
 
-void FrameBroadcaster::send(const geometry_msgs::TransformStamped& frame) {
+void FrameBroadcaster::send(const std_msgs::Header& header, const std::string& child,
+                            const std::vector<double>& position) {
   if (!heard()) return;
   tf2_msgs::TFMessage message;
-  message.transforms.push_back(frame);
+  message.transforms.push_back(frameAt(header, child, position));
   pub_.publish(message);
 }
 

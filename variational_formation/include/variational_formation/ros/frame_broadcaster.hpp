@@ -2,6 +2,8 @@
 
 #include <atomic>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include <geometry_msgs/TransformStamped.h>
 #include <ros/ros.h>
@@ -19,10 +21,10 @@ namespace vf {
 class FrameBroadcaster {
  public:
   explicit FrameBroadcaster(ros::NodeHandle& nh);
-  /// Whether /tf has a subscriber now: only then is send() worth a transform.
+  /// Whether /tf has a subscriber now.
   bool heard() const { return *listeners_ > 0; }
-  /// Publishes `frame` on /tf if heard().
-  void send(const geometry_msgs::TransformStamped& frame);
+  /// Publishes frameAt(header, child, position) on /tf if heard(); builds nothing otherwise.
+  void send(const std_msgs::Header& header, const std::string& child, const std::vector<double>& position);
 
  private:
   std::shared_ptr<std::atomic<int>> listeners_ = std::make_shared<std::atomic<int>>(0);

@@ -65,12 +65,7 @@ class Formation {
    */
   template <class Column>
   void agentGradientFrom(int agent, const double* qi, Column column, double* out) const {
-    for (int c = 0; c < dimension_; ++c) out[c] = 0.0;
-    for (const Neighbour& nb : neighbours_[agent]) {
-      const double* qj = column(nb.agent);
-      const double gamma = squaredDistance(qi, qj, dimension_) - nb.desiredDistanceSquared;
-      for (int c = 0; c < dimension_; ++c) out[c] += gamma * (qi[c] - qj[c]);
-    }
+    agentScaledGradientFrom(agent, qi, column, 1.0, out);  // 1.0 * d_ij^2 is d_ij^2 exactly
   }
   /**
    * grad_i V_s for the scaled distances s d_ij (doc/maths.md §9): gamma_ij = |q_i - q_j|^2 - s^2 d_ij^2.
