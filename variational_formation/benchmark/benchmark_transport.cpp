@@ -1,29 +1,34 @@
 // The ceiling the transport sets for a nodelet run (README, "Throughput"): the lockstep message
 // pattern of `formation.launch nodelet:=true` with no maths and no protocol. N agents in this one
 // process, a ring with chords (neighbours i±1, i±2), each publishes AgentState step k + 1 as soon
-// as it holds its neighbours' step k; intra-process, as shared pointers, on one spinner thread.
-// One more subscriber stands for the monitor: on every agent's topic (--collector topics, the
-// pattern before batching) or on one batch topic that gets every state (--collector batch); in
-// this process, or with --remote in a second process (forked before ROS starts), over TCP as the
-// monitor gets them. Prints the steps/s from the first publication (remote: the first message
-// collected) to the last state collected.
+// as it holds its neighbours' step k, as shared pointers. One more subscriber stands for the
+// monitor: on every agent's topic (--collector topics, the pattern before batching) or on one
+// batch topic that gets every state (--collector batch), read as the monitor reads it
+// (subscribeToBatches); in this process, or with --remote in a second process (forked before ROS
+// starts), over TCP as the monitor gets them. Prints the steps/s from the first publication
+// (remote: the first message collected) to the last state collected.
 //
-// --delivery local (the default) hands the states between the agents of the process as an
-// agent_manager does (doc/distributed.md, "Local delivery"): through a LocalExchange, one queued
-// call per state and listener, each agent's topic silent until a subscriber in another
-// process connects (TopicAudience), so the in-process collector of `--collector topics`
-// listens to the exchange too. --delivery roscpp publishes every state on its topic, as before:
-// roscpp's publish finds the topic by a linear search through all of the process's publications,
-// so its cost per agent-step grows with the agents (doc/benchmarks.md).
+// --delivery manager (the default) is an agent_manager's transport as it is (doc/distributed.md,
+// "Local delivery" and "Threads"), with the package's own classes: the agents' callbacks on the
+// one thread of AgentThreads, each state handed through the LocalExchange into its neighbours'
+// inboxes and read right after (AgentThreads::soon), each agent's topic silent until a subscriber
+// in another process connects (TopicAudience), the batches made by StateBatch, and every agent's
+// messages reused once nothing holds them (as AgentNode::makeState). --delivery local is the
+// exchange with one queued call per state and listener on roscpp's global queue, spun by the main
+// thread (this benchmark's default until issue 34's last round). --delivery roscpp publishes every
+// state on its topic: roscpp's publish finds the topic by a linear search through all of the
+// process's publications, so its cost per agent-step grows with the agents (doc/benchmarks.md).
 //
 // usage: benchmark_transport [--agents N] [--steps S] [--collector topics|batch] [--remote]
-//        [--delivery local|roscpp]
+//        [--delivery manager|local|roscpp]
 //        (needs a master; benchmark/transport_ceiling.sh starts one)
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
@@ -34,11 +39,14 @@
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 
+#include <std_msgs/Int64.h>
+
 #include "variational_formation_msgs/AgentState.h"
 #include "variational_formation_msgs/AgentStates.h"
 #include "variational_formation_core/protocol/local_exchange.hpp"
 #include "variational_formation_core/protocol/topic_audience.hpp"
 #include "variational_formation/ros/pacer.hpp"
+#include "variational_formation/ros/state_batch.hpp"
 
 namespace {
 using variational_formation_msgs::AgentState;
@@ -52,22 +60,46 @@ struct Agent {
   std::vector<int> neighbours;
   std::vector<long> heard;  // newest step held of each neighbour
   long step = 0;
+  // --delivery manager: neighbours' states handed over on the agents' thread, and this agent's
+  // messages, reused once nothing else holds them.
+  std::deque<std::pair<std::size_t, AgentState::ConstPtr>> inbox;
+  bool inboxRead = false;
+  std::deque<AgentState::Ptr> made;
+  long allowed = 0;  // the flow window's end: this agent computes step k only while k <= allowed
 };
 
 struct Bench {
   int n = 100;
   long steps = 2000;
   bool batch = false;
+  bool manager = false;                 // --delivery manager
+  ros::CallbackQueue* queue = nullptr;  // --delivery manager: the agents' queue (AgentThreads)
   std::unique_ptr<Exchange> exchange;  // --delivery local: the agents' process hands states over itself
   std::vector<Agent> agents;
   std::vector<ros::Subscriber> subs;
   ros::Publisher batchPub;
   AgentStates::Ptr pending;
   long collected = 0;
+  // The flow window, as the monitor's ~window: an agent computes step k only while k <= its
+  // allowed, the collector's completed step + window, sent on bench/progress every quarter window
+  // to each agent's own subscription (as each agent's RunProgress).
+  long window = 100;
+  long announced = 0;  // the collector's last completed step sent
+  ros::Publisher progressPub;
 
   void publish(int i) {
     Agent& a = agents[static_cast<std::size_t>(i)];
-    auto msg = boost::make_shared<AgentState>();
+    AgentState::Ptr msg;
+    if (manager && !a.made.empty() && a.made.front().use_count() == 1) {
+      msg = std::move(a.made.front());
+      a.made.pop_front();
+    } else {
+      msg = boost::make_shared<AgentState>();
+    }
+    if (manager) {
+      a.made.push_back(msg);
+      if (a.made.size() > 16) a.made.pop_front();
+    }
     msg->id = static_cast<uint32_t>(i);
     msg->step = a.step;
     msg->position = {1.0 * i, 0.5 * a.step};
@@ -79,7 +111,9 @@ struct Bench {
       exchange->deliver(i, state);
       if (a.audience->published(state)) a.pub.publish(state);
     }
-    if (batch) {
+    if (manager) {
+      if (batch) vf::StateBatch::local()->add(state);
+    } else if (batch) {
       pending->states.push_back(*msg);
       if (static_cast<int>(pending->states.size()) == n) {
         batchPub.publish(AgentStates::ConstPtr(pending));
@@ -89,13 +123,20 @@ struct Bench {
   }
   void tryAdvance(int i) {
     Agent& a = agents[static_cast<std::size_t>(i)];
-    while (a.step < steps) {
+    while (a.step < steps && a.step < a.allowed) {
       for (long h : a.heard) {
         if (h < a.step) return;
       }
       ++a.step;
       publish(i);
     }
+  }
+  /// The collector's completed step, to agent i: it may go `window` steps past it.
+  void onProgress(int i, long completed) {
+    Agent& a = agents[static_cast<std::size_t>(i)];
+    if (completed + window <= a.allowed) return;
+    a.allowed = completed + window;
+    tryAdvance(i);
   }
   void onNeighbour(int i, std::size_t k, const AgentState::ConstPtr& msg) {
     Agent& a = agents[static_cast<std::size_t>(i)];
@@ -109,12 +150,39 @@ struct Bench {
       vf::queueCall(ros::getGlobalCallbackQueue(), [f, m] { f(m); }, 0);
     });
   }
+  /// --delivery manager: agent i hears its k-th neighbour as AgentNode::listenLocally does: on
+  /// the agents' thread into its inbox, read right after; from any other thread, a call on its queue.
+  void listenAsManager(int i, std::size_t k) {
+    exchange->listen(agents[static_cast<std::size_t>(i)].neighbours[k], static_cast<std::uintptr_t>(i),
+                     [this, i, k](int, const AgentState::ConstPtr& m) {
+                       Agent& a = agents[static_cast<std::size_t>(i)];
+                       if (vf::AgentThreads::serves(queue)) {
+                         a.inbox.emplace_back(k, m);
+                         if (!a.inboxRead) {
+                           a.inboxRead = true;
+                           vf::AgentThreads::soon([this, i] { readInbox(i); });
+                         }
+                         return;
+                       }
+                       vf::queueCall(queue, [this, i, k, m] { onNeighbour(i, k, m); }, 0);
+                     });
+  }
+  void readInbox(int i) {
+    Agent& a = agents[static_cast<std::size_t>(i)];
+    a.inboxRead = false;
+    while (!a.inbox.empty()) {
+      const std::pair<std::size_t, AgentState::ConstPtr> arrived = std::move(a.inbox.front());
+      a.inbox.pop_front();
+      onNeighbour(i, arrived.first, arrived.second);
+    }
+  }
 };
 }  // namespace
 
 int main(int argc, char** argv) {
   Bench b;
   bool remote = false, local = true;
+  std::string delivery = "manager";
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
     const bool value = k + 1 < argc;
@@ -129,28 +197,31 @@ int main(int argc, char** argv) {
         return 2;
       }
       b.batch = c == "batch";
+    } else if (a == "--window" && value) {
+      b.window = std::atol(argv[++k]);
     } else if (a == "--remote") {
       remote = true;
     } else if (a == "--delivery" && value) {
-      const std::string d = argv[++k];
-      if (d != "local" && d != "roscpp") {
-        std::fprintf(stderr, "benchmark_transport: --delivery: local or roscpp, got '%s'\n", d.c_str());
+      delivery = argv[++k];
+      if (delivery != "manager" && delivery != "local" && delivery != "roscpp") {
+        std::fprintf(stderr, "benchmark_transport: --delivery: manager, local or roscpp, got '%s'\n", delivery.c_str());
         return 2;
       }
-      local = d == "local";
     } else if (a == "--help" || a == "-h") {
       std::puts("usage: benchmark_transport [--agents N] [--steps S] [--collector topics|batch] [--remote] "
-                "[--delivery local|roscpp]");
+                "[--delivery manager|local|roscpp] [--window W]");
       return 0;
     } else {
       std::fprintf(stderr, "benchmark_transport: unknown or incomplete argument '%s' (see --help)\n", a.c_str());
       return 2;
     }
   }
-  if (b.n < 5 || b.steps < 1) {
-    std::fprintf(stderr, "benchmark_transport: needs --agents >= 5 and --steps >= 1\n");
+  if (b.n < 5 || b.steps < 1 || b.window < 1) {
+    std::fprintf(stderr, "benchmark_transport: needs --agents >= 5, --steps >= 1 and --window >= 1\n");
     return 2;
   }
+  local = delivery != "roscpp";
+  b.manager = delivery == "manager";
   const pid_t collector = remote ? fork() : 0;
   const bool collects = !remote || collector == 0;  // this process holds the collector
   const bool runsAgents = !remote || collector > 0;
@@ -158,6 +229,9 @@ int main(int argc, char** argv) {
             ros::init_options::AnonymousName | ros::init_options::NoSigintHandler);
   ros::NodeHandle nh("bench");
   b.agents.resize(static_cast<std::size_t>(b.n));
+  // Nothing paces the agents to the collector here (a run's monitor does, with its window): every
+  // queue holds the whole run, so no state is dropped for a collector that falls behind.
+  const auto depth = static_cast<uint32_t>(std::min<long>(b.steps + 10, 100000000L / b.n));
   b.pending = boost::make_shared<AgentStates>();
   const long total = static_cast<long>(b.n) * b.steps;  // states after step 0
   auto start = std::chrono::steady_clock::now(), done = start;
@@ -166,6 +240,13 @@ int main(int argc, char** argv) {
     if (first && remote) start = std::chrono::steady_clock::now();
     first = false;
     b.collected += states;
+    const long completed = b.collected / b.n;  // steps come whole and in order (the agents wait on each other)
+    if (completed >= b.announced + std::max(1L, b.window / 4)) {
+      b.announced = completed;
+      std_msgs::Int64 progress;
+      progress.data = completed;
+      b.progressPub.publish(progress);
+    }
     if (b.collected >= total) {
       done = std::chrono::steady_clock::now();
       ros::shutdown();
@@ -175,17 +256,22 @@ int main(int argc, char** argv) {
     std::vector<int> ids;
     for (int i = 0; i < b.n; ++i) ids.push_back(i);
     b.exchange = std::make_unique<Exchange>(ids);
+    if (b.manager) {
+      vf::AgentThreads::start(1, static_cast<std::size_t>(b.n));
+      b.queue = vf::AgentThreads::local()->nextQueue();
+      if (b.batch) vf::StateBatch::start(nh, ids);  // on bench/states, as a manager's ~states
+    }
   }
   for (int i = 0; i < b.n; ++i) {
     Agent& a = b.agents[static_cast<std::size_t>(i)];
     if (!b.exchange) {
-      a.pub = nh.advertise<AgentState>("agent_" + std::to_string(i), 1000);
+      a.pub = nh.advertise<AgentState>("agent_" + std::to_string(i), depth);
       continue;
     }
     a.audience = std::make_unique<vf::TopicAudience<AgentState::ConstPtr>>(ros::this_node::getName());
     vf::TopicAudience<AgentState::ConstPtr>* audience = a.audience.get();
     ros::AdvertiseOptions options = ros::AdvertiseOptions::create<AgentState>(
-        "agent_" + std::to_string(i), 1000,
+        "agent_" + std::to_string(i), depth,
         [audience](const ros::SingleSubscriberPublisher& s) {
           if (const AgentState::ConstPtr newest = audience->connected(s.getSubscriberName())) s.publish(*newest);
         },
@@ -193,32 +279,45 @@ int main(int argc, char** argv) {
     options.latch = true;  // as an agent_manager's agents (TopicAudience)
     a.pub = nh.advertise(options);
   }
-  if (b.batch) b.batchPub = nh.advertise<AgentStates>("states", 1000);
+  if (b.batch && !b.manager && runsAgents) b.batchPub = nh.advertise<AgentStates>("states", depth);
   for (int i = 0; i < b.n; ++i) {
     Agent& a = b.agents[static_cast<std::size_t>(i)];
     for (int d : {-2, -1, 1, 2}) a.neighbours.push_back((i + d + b.n) % b.n);
     a.heard.assign(a.neighbours.size(), 0);
     for (std::size_t k = 0; runsAgents && k < a.neighbours.size(); ++k) {
+      if (b.manager) {
+        b.listenAsManager(i, k);
+        continue;
+      }
       if (b.exchange) {
         b.listen(a.neighbours[k], static_cast<std::uintptr_t>(i), [&b, i, k](const AgentState::ConstPtr& m) { b.onNeighbour(i, k, m); });
         continue;
       }
-      b.subs.push_back(nh.subscribe<AgentState>("agent_" + std::to_string(a.neighbours[k]), 1000,
+      b.subs.push_back(nh.subscribe<AgentState>("agent_" + std::to_string(a.neighbours[k]), depth,
                                                 [&b, i, k](const AgentState::ConstPtr& m) { b.onNeighbour(i, k, m); }));
     }
     if (collects && !b.batch && b.exchange) {  // the collector in the agents' process
       b.listen(i, static_cast<std::uintptr_t>(b.n + i), [&count](const AgentState::ConstPtr& m) { count(m->step > 0 ? 1 : 0); });
     } else if (collects && !b.batch) {
-      b.subs.push_back(nh.subscribe<AgentState>("agent_" + std::to_string(i), 1000,
+      b.subs.push_back(nh.subscribe<AgentState>("agent_" + std::to_string(i), depth,
                                                 [&count](const AgentState::ConstPtr& m) { count(m->step > 0 ? 1 : 0); }));
     }
   }
   if (collects && b.batch) {
-    b.subs.push_back(nh.subscribe<AgentStates>("states", 1000, [&count](const AgentStates::ConstPtr& m) {
+    b.subs.push_back(vf::subscribeToBatches(nh, "states", depth, [&count](const ros::MessageEvent<AgentStates const>& e) {
       long states = 0;
-      for (const auto& s : m->states) states += s.step > 0 ? 1 : 0;
+      for (const auto& s : e.getConstMessage()->states) states += s.step > 0 ? 1 : 0;
       count(states);
     }));
+  }
+  if (collects) b.progressPub = nh.advertise<std_msgs::Int64>("progress", 100);
+  for (int i = 0; runsAgents && i < b.n; ++i) {  // on the agents' queue, one each, as their RunProgress
+    b.agents[static_cast<std::size_t>(i)].allowed = b.window;
+    ros::SubscribeOptions options = ros::SubscribeOptions::create<std_msgs::Int64>(
+        "progress", 100, [&b, i](const std_msgs::Int64::ConstPtr& m) { b.onProgress(i, m->data); }, ros::VoidConstPtr(),
+        b.manager ? b.queue : nullptr);
+    options.transport_hints = ros::TransportHints().tcpNoDelay();
+    b.subs.push_back(nh.subscribe(options));
   }
   if (!runsAgents) {  // the remote collector: count until everything came
     ros::spin();
@@ -227,18 +326,27 @@ int main(int argc, char** argv) {
     ros::WallDuration(remote ? 3.0 : 1.0).sleep();
     for (int i = 0; i < 20 && ros::ok(); ++i) ros::spinOnce();
     start = std::chrono::steady_clock::now();
-    for (int i = 0; i < b.n; ++i) b.publish(i);
+    if (b.manager) {  // on the agents' thread, where every agent's callbacks run
+      vf::queueCall(b.queue, [&b] { for (int i = 0; i < b.n; ++i) b.publish(i); }, 0);
+    } else {
+      for (int i = 0; i < b.n; ++i) b.publish(i);
+    }
+    int status = 0;
     if (!remote) {
       ros::spin();
-    } else {  // serve the collector until it exits
-      int status = 0;
+    } else if (b.manager) {  // serve the collector until it exits; the main thread waits, as a manager's
+      while (waitpid(collector, &status, WNOHANG) == 0) ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.01));
+    } else {  // the main thread is the agents' one: it spins
       while (waitpid(collector, &status, WNOHANG) == 0) ros::spinOnce();
-      return WIFEXITED(status) ? WEXITSTATUS(status) : 1;
     }
+    b.subs.clear();            // before the queue they call on goes
+    vf::AgentThreads::stop();  // before the batch and the exchange they use
+    vf::StateBatch::stop();
+    if (remote) return WIFEXITED(status) ? WEXITSTATUS(status) : 1;
   }
   const double seconds = std::chrono::duration<double>(done - start).count();
   std::printf("benchmark_transport: %d agents, %ld steps, collector %s%s, %s delivery: %.3f s, %.0f steps/s\n", b.n,
               b.steps, b.batch ? "batch" : "topics", remote ? " (another process)" : " (this process)",
-              local ? "local" : "roscpp", seconds, b.steps / seconds);
+              delivery.c_str(), seconds, b.steps / seconds);
   return b.collected >= total ? 0 : 1;
 }

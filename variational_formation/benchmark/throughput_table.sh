@@ -1,9 +1,13 @@
 #!/usr/bin/env bash
 # README's throughput table in one run: for each agent count, scripts/benchmark_ros.sh with
 # nodelets (ring with chords, h = 0.005 s, no recording) next to the transport's ceiling for the same
-# pattern (benchmark_transport: agents in one process handing states over as an agent_manager
-# does, the monitor's part in another over TCP, reading one batch per step). Prints a Markdown table, then each target of issue 34 with its
-# ratio and pass or fail. Columns:
+# pattern (benchmark_transport --delivery manager: agents in one process handing states over with
+# an agent_manager's own classes, its thread, inboxes, batches and reused messages, paced by a
+# window of 100 steps as the monitor paces them; the monitor's part in another process over TCP,
+# reading one batch per step and only counting). Prints a Markdown table, then each target of
+# issue 34 with its ratio and pass or fail. (Until this round the ceiling was --delivery local,
+# the exchange through roscpp's global queue, which an agent_manager no longer uses: 3 to 5 times
+# slower than the manager's own transport, and not linear; doc/benchmarks.md.) Columns:
 #   steps/s: the lockstep run's; agent-steps/s: steps/s x agents; µs per agent-step: its inverse
 #   (wall time, the machine's 2 cores shared by the manager and the monitor);
 #   ratio to R: agent-steps/s over the same at the reference count R (100 if listed, else the
@@ -45,7 +49,7 @@ for n in "${counts[@]}"; do
     master=$!
     sleep 1
     c=$(ROS_MASTER_URI="http://localhost:$port" timeout 300 "$WS/devel/lib/variational_formation/benchmark_transport" \
-          --agents "$n" --steps "$steps" --collector batch --remote 2>/dev/null |
+          --agents "$n" --steps "$steps" --collector batch --remote --delivery manager 2>/dev/null |
         sed -nE 's/.* ([0-9]+) steps\/s$/\1/p')
     kill "$master" 2>/dev/null || true
     wait "$master" 2>/dev/null || true

@@ -155,9 +155,10 @@ target_compile_options(robot_sim PRIVATE ${VF_FLAGS})
 add_dependencies(robot_sim ${catkin_EXPORTED_TARGETS})
 install(TARGETS robot_sim RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
-# The transport's ceiling for a nodelet run (benchmark/transport_ceiling.sh), built for the
+# The transport's ceiling for a nodelet run (benchmark/transport_ceiling.sh; the package's own
+# AgentThreads, StateBatch and batch reading from variational_formation_ros), built for the
 # checkout only, like benchmark_roa.
 add_executable(benchmark_transport benchmark/benchmark_transport.cpp)
 add_dependencies(benchmark_transport ${catkin_EXPORTED_TARGETS})
-target_link_libraries(benchmark_transport ${variational_formation_core_LIBRARIES} ${catkin_LIBRARIES})
+target_link_libraries(benchmark_transport variational_formation_ros ${variational_formation_core_LIBRARIES} ${catkin_LIBRARIES})
 target_compile_options(benchmark_transport PRIVATE ${VF_FLAGS})

@@ -42,8 +42,13 @@ if [ ! -f "$result" ]; then
   echo "run_formation: the run failed before the monitor started (roslaunch exit status $status; see above)" >&2
   [ "$status" -ne 0 ] && exit "$status" || exit 1
 fi
-outcome="$(sed -n 's/^result: //p' "$result")"
-formation="$(sed -n 's/^formation: //p' "$result" | tr -d '"')"
+# A field of the result file, as YAML reads it (its strings are quoted and escaped).
+field() {
+  /usr/bin/python3 -c 'import sys, yaml; v = (yaml.safe_load(open(sys.argv[1])) or {}).get(sys.argv[2]); print("" if v is None else v)' \
+    "$result" "$1" 2>/dev/null || echo "(unreadable result file $result)"
+}
+outcome="$(field result)"
+formation="$(field formation)"
 case "$outcome" in
   succeeded|stopped)
     case "$formation" in
@@ -51,5 +56,5 @@ case "$outcome" in
       "edges converged"*) echo "run_formation: the run $outcome, but the formation is not in the desired shape: $formation" >&2 ;;
     esac
     exit 0 ;;
-  *) echo "run_formation: the run $outcome: $(sed -n 's/^reason: //p' "$result" | tr -d '"')" >&2; exit 1 ;;
+  *) echo "run_formation: the run $outcome: $(field reason)" >&2; exit 1 ;;
 esac

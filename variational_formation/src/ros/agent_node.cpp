@@ -122,6 +122,7 @@ void AgentNode::carryOut(const Protocol::Ready& ready) {
   if (!ready.failed.empty()) ROS_ERROR("%s: %s; ending the run", name_.c_str(), ready.failed.c_str());
   for (const AgentState::ConstPtr& state : ready.publish) publish(state);
   if (!ready.dropped.empty()) drop(ready.dropped);
+  if (!ready.note.empty()) ROS_INFO("%s: %s", name_.c_str(), ready.note.c_str());
   if (!ready.over.empty()) ROS_INFO("%s: %s", name_.c_str(), ready.over.c_str());
   if (ready.resumedAt >= 0) ROS_INFO("%s: resumed at step %ld, the holders' newer state of mine", name_.c_str(), ready.resumedAt);
   if (ready.recallAgain) recallAgain();

@@ -7,6 +7,7 @@
 #include <rosgraph_msgs/Clock.h>
 
 #include "variational_formation_core/agents/run_verdict.hpp"
+#include "variational_formation_core/common/yaml_text.hpp"
 #include "variational_formation/ros/markers.hpp"
 #include "variational_formation/ros/monitor_node.hpp"
 #include "variational_formation/ros/output_files.hpp"
@@ -91,19 +92,14 @@ void MonitorNode::publishClock() {
 
 void MonitorNode::writeResult(const std::string& result, const std::string& reason) const {
   if (resultFile_.empty()) return;
-  auto quoted = [](const std::string& text) {
-    std::string out = "\"";
-    for (char c : text) out += c == '"' ? std::string("\\\"") : std::string(1, c);
-    return out + "\"";
-  };
   const ShapeOutcome formation = shapeVerdict();
   std::ostringstream f;
-  f << "result: " << result << "\nscenario: " << scenario_.name << "\nsteps: " << scenario_.steps
+  f << "result: " << result << "\nscenario: " << yamlQuoted(scenario_.name) << "\nsteps: " << scenario_.steps
     << "\ncompleted_step: " << completedStep() << "\nconverged_step: " << formation.convergedStep
     << "\nshape_error: " << formation.findings.shapeError << "\nformation: "
-    << quoted(formation.line) << "\nfinal_max_distance_error: " << finalError_ << "\ndropped: " << dropped_ << "\ncommands: " << commandsIssued()
+    << yamlQuoted(formation.line) << "\nfinal_max_distance_error: " << finalError_ << "\ndropped: " << dropped_ << "\ncommands: " << commandsIssued()
     << "\ncommands_refused: " << commandsRefused_ << "\ncommands_saturated: " << desk_->saturated()
-    << "\nreason: " << quoted(reason) << "\n" << safetyResultLines() << robotsResultLines();
+    << "\nreason: " << yamlQuoted(reason) << "\n" << safetyResultLines() << robotsResultLines();
   // Whole or not at all: a test or script polling the file never reads half of it.
   if (!replaceFileWith(resultFile_, f.str())) ROS_ERROR("monitor: cannot write the result file %s", resultFile_.c_str());
 }

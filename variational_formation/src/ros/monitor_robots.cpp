@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "variational_formation_core/common/number_checks.hpp"
+#include "variational_formation_core/common/yaml_text.hpp"
 #include "variational_formation_core/robots/robot_link.hpp"
 #include "variational_formation/ros/monitor_node.hpp"
 #include "variational_formation/ros/parameters.hpp"
@@ -101,7 +102,7 @@ std::string MonitorNode::robotsResultLines() const {
   std::ostringstream out;
   out << "robots_in_shape_step: " << robots.convergedStep << "\nrobots_max_distance_error: "
       << robots.findings.maxEdgeError << "\nrobots_shape_error: " << robots.findings.shapeError
-      << "\nrobots: \"" << robots.line << "\"\nagents_converged_step: " << agents.convergedStep
+      << "\nrobots: " << yamlQuoted(robots.line) << "\nagents_converged_step: " << agents.convergedStep
       << "\nodometry_dropped: " << badOdometry_ << "\n";
   return out.str();
 }

@@ -21,6 +21,8 @@ namespace {
 
 using test::Message;
 using test::World;
+using test::AgentProtocol;
+using test::State;
 
 Scenario shortScenario(const std::string& name, long steps) {
   Scenario s = loadScenario(test::configPath(name));
@@ -70,6 +72,32 @@ TEST(Recovery, AgentResumesFromTheNewestHolderAndTheFirstOnATie) {
   EXPECT_EQ(protocol::chooseAgentResume({}), -1);
   EXPECT_EQ(protocol::chooseAgentResume({{true, true, 0}, {false, true, 9}}), -1);  // step 0 or unanswered
   EXPECT_EQ(protocol::chooseAgentResume({{true, true, 4}, {true, false, 9}, {true, true, 7}, {true, true, 7}}), 2);
+}
+
+// A restarted agent's holders may answer before the dead incarnation's last states reach them:
+// an answer no newer than the agent's own step moves nothing and is a note to log, not a dropped
+// state (AgentNode counts dropped ones in its status and the result file). A bad answer is still
+// dropped.
+TEST(Recovery, AnAnswerThatIsNotNewerIsANoteNotADroppedState) {
+  const Scenario s = shortScenario("hexagon", 24);
+  AgentProtocol a(LockstepAgent(s, 1), [](const LockstepAgent& c, const std::string&) {
+    return std::make_shared<const State>(State{c.id(), c.step(), c.position(), c.previousPosition()});
+  });
+  ASSERT_EQ(a.start().publish.size(), 1u);  // step 0
+  const AgentProtocol::Ready stale = a.step(AgentProtocol::Recalled{});  // step -1: nothing beyond step 0
+  EXPECT_TRUE(stale.dropped.empty()) << stale.dropped;
+  EXPECT_NE(stale.note.find("is not past step 0; waiting for a newer one"), std::string::npos) << stale.note;
+  EXPECT_TRUE(stale.publish.empty());
+  EXPECT_EQ(stale.resumedAt, -1);
+  EXPECT_EQ(a.agent().step(), 0);
+  const AgentProtocol::Ready bad = a.step(AgentProtocol::Recalled{5, {1.0}, {1.0}});  // one coordinate in 2-D
+  EXPECT_NE(bad.dropped.find("a recalled state: resume: expected 2 coordinates"), std::string::npos) << bad.dropped;
+  EXPECT_TRUE(bad.note.empty()) << bad.note;
+  EXPECT_EQ(bad.resumedAt, -1);
+  const AgentProtocol::Ready newer = a.step(AgentProtocol::Recalled{5, {1.0, 2.0}, {1.0, 2.0}});
+  EXPECT_TRUE(newer.dropped.empty() && newer.note.empty()) << newer.dropped << newer.note;
+  EXPECT_EQ(newer.resumedAt, 5);
+  EXPECT_EQ(a.agent().step(), 5);
 }
 
 TEST(Recovery, MonitorResumesAfterTheNewestProgressHeard) {

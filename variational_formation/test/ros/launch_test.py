@@ -95,10 +95,10 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
     def tearDownClass(cls):
         shutil.rmtree(cls.tmp, ignore_errors=True)
 
-    def scenario_variant(self, name, **fields):
+    def scenario_variant(self, file_name, **fields):
         s = {k: v for k, v in self.scenario.items() if k not in ("n", "neighbours")}
         s.update(fields)
-        path = os.path.join(self.tmp, name + ".yaml")
+        path = os.path.join(self.tmp, file_name + ".yaml")
         with open(path, "w") as f:
             yaml.safe_dump(s, f)
         return path
@@ -118,8 +118,11 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
         self.assertRegex(done["formation"], r"^converged to the desired shape at step \d+ \(t = [0-9.]+ s\)$")
         self.assertEqual(int(done["formation"].split()[7]), done["converged_step"])
         self.assertLess(done["shape_error"], 0.01 * 3.0)  # every pair within 1 % (the hexagon's side is 3 m)
+        # The strict variant's own name holds what YAML would misread unescaped: the result file
+        # quotes and escapes it (yamlQuoted), so it reads back as written.
+        odd_name = 'short "strict": C:\\runs\\new #2 \\'
         for name, strict in (("short", False), ("short_strict", True)):
-            fields = dict(steps=20, require_convergence=True) if strict else dict(steps=20)
+            fields = dict(steps=20, require_convergence=True, name=odd_name) if strict else dict(steps=20)
             path = self.scenario_variant(name, **fields)
             out = os.path.join(self.tmp, name)
             run = run_formation(f"scenario:={path}", f"output_dir:={out}")
@@ -130,6 +133,7 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
             self.assertGreater(result["final_max_distance_error"], 0.0)
             if strict:
                 self.assertNotEqual(run.returncode, 0, run.stdout[-3000:])
+                self.assertEqual(result["scenario"], odd_name)
                 self.assertEqual(result["result"], "failed")
                 self.assertIn("the formation did not converge", result["reason"])
                 self.assertIn("requires it (require_convergence: true)", run.stderr)

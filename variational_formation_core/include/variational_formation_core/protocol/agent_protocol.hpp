@@ -51,7 +51,8 @@ class AgentProtocol {
   struct Ready {
     std::vector<StatePtr> publish;  ///< states to publish, oldest first (already in the history)
     std::string failed;             ///< "" or why this agent ends the run (the last state says it too)
-    std::string dropped;            ///< "" or what was dropped and why
+    std::string dropped;            ///< "" or what was dropped and why (counted in the agent's `dropped`)
+    std::string note;               ///< "" or a line to log: an answer that did not move the agent on (not counted)
     std::string over;               ///< "" or: the run just ended (a line to log)
     bool wakeWhenSensed = false;    ///< waits for states: wake (Wake) when the shared board holds the step
     double wakeAfter = -1.0;        ///< >= 0: the pacing timer; wake (Wake) after this many seconds
@@ -117,8 +118,10 @@ class AgentProtocol {
     Ready r;
     recalling_ = false;
     if (e.step <= agent_.step() || agent_.advancedSinceResume()) {
-      r.dropped = "the holders' newest state of this agent (step " + std::to_string(e.step) +
-                  ") is not past step " + std::to_string(agent_.step()) + "; waiting for a newer one";
+      // Nothing was dropped: the holders simply hold nothing newer yet (their answer can come
+      // before the dead incarnation's last states reach them). The next newer state asks again.
+      r.note = "the holders' newest state of this agent (step " + std::to_string(e.step) +
+               ") is not past step " + std::to_string(agent_.step()) + "; waiting for a newer one";
       return r;
     }
     try {
