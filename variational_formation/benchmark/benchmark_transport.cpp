@@ -229,9 +229,9 @@ int main(int argc, char** argv) {
             ros::init_options::AnonymousName | ros::init_options::NoSigintHandler);
   ros::NodeHandle nh("bench");
   b.agents.resize(static_cast<std::size_t>(b.n));
-  // Nothing paces the agents to the collector here (a run's monitor does, with its window): every
-  // queue holds the whole run, so no state is dropped for a collector that falls behind.
-  const auto depth = static_cast<uint32_t>(std::min<long>(b.steps + 10, 100000000L / b.n));
+  // The window keeps the agents within window + a quarter of it of the collector: every queue
+  // holds twice the window, as the monitor's own, so none drops a state.
+  const auto depth = static_cast<uint32_t>(std::min<long>(2 * b.window + 10, 1000000L));
   b.pending = boost::make_shared<AgentStates>();
   const long total = static_cast<long>(b.n) * b.steps;  // states after step 0
   auto start = std::chrono::steady_clock::now(), done = start;
