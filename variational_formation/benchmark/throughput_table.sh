@@ -6,7 +6,7 @@
 # window of 100 steps as the monitor paces them; the monitor's part in another process over TCP,
 # reading one batch per step and only counting). Prints a Markdown table, then each target of
 # issue 34 with its ratio and pass or fail. (Until this round the ceiling was --delivery local,
-# the exchange through roscpp's global queue, which an agent_manager no longer uses: 3 to 5 times
+# the exchange through roscpp's global queue, which an agent_manager no longer uses: 2.3 to 3.4 times
 # slower than the manager's own transport, and not linear; doc/benchmarks.md.) Columns:
 #   steps/s: the lockstep run's; agent-steps/s: steps/s x agents; µs per agent-step: its inverse
 #   (wall time, the machine's 2 cores shared by the manager and the monitor);
