@@ -89,6 +89,7 @@ void AgentNode::advertiseState(ros::NodeHandle& nh) {
 AgentNode::~AgentNode() {
   if (exchange_) exchange_->stopListening(reinterpret_cast<std::uintptr_t>(this));
   *alive_ = false;
+  inboxReader_->node = nullptr;
   Pacer::instance().cancel(reinterpret_cast<uint64_t>(this));
 }
 
@@ -203,9 +204,12 @@ void AgentNode::publish(const AgentState::ConstPtr& state) {
 
 void AgentNode::reportWaiting() {
   if (protocol_->exitStatus() >= 0) return;
-  const double stepAt = protocol_->lastStepAt();
-  const ros::WallTime last = stepAt < 0.0 ? lastReportAt_ : std::max(ros::WallTime(stepAt), lastReportAt_);
-  if (secondsSince(last) < kReportEvery) return;
+  // Seen to move since the last look (every kReportEvery / 2): it is not waiting.
+  if (agent().step() != stepSeen_) {
+    stepSeen_ = agent().step();
+    stepSeenAt_ = ros::WallTime::now();
+  }
+  if (secondsSince(std::max(stepSeenAt_, lastReportAt_)) < kReportEvery) return;
   ROS_INFO("%s: at step %ld, waiting for %s", name_.c_str(), agent().step(), protocol_->waitingFor(monitor_).c_str());
   lastReportAt_ = ros::WallTime::now();
 }
@@ -226,9 +230,7 @@ void AgentNode::listenLocally() {
                           inbox_.emplace_back(source, state);
                           if (!inboxRead_) {
                             inboxRead_ = true;
-                            AgentThreads::soon([this, alive] {
-                              if (*alive) readInbox();
-                            });
+                            AgentThreads::soon(inboxReader_);
                           }
                           return;
                         }
@@ -241,11 +243,16 @@ void AgentNode::listenLocally() {
 
 void AgentNode::readInbox() {
   inboxRead_ = false;
-  while (!inbox_.empty()) {
-    const std::pair<int, AgentState::ConstPtr> arrived = std::move(inbox_.front());
-    inbox_.pop_front();
-    carryOut(protocol_->step(Protocol::StateArrived{arrived.first, arrived.second}));
+  // Only the thread's lane calls this, never from within itself: one Ready serves every state
+  // read here, and the inbox is read by index (a state handed over meanwhile goes to its end
+  // and is read in this loop too), both keeping their memory.
+  for (std::size_t k = 0; k < inbox_.size(); ++k) {
+    const std::pair<int, AgentState::ConstPtr> arrived = std::move(inbox_[k]);
+    protocol_->step(Protocol::StateArrived{arrived.first, arrived.second}, ready_);
+    carryOut(ready_);
   }
+  inbox_.clear();
+  ready_.clear();  // holds no state past its use
 }
 
 void AgentNode::start(const Recovery& recovery) {
@@ -262,6 +269,8 @@ void AgentNode::start(const Recovery& recovery) {
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
   carryOut(protocol_->start());  // the first state (step 0, or the recovered one), latched
   lastReportAt_ = ros::WallTime::now();
+  stepSeen_ = agent().step();
+  stepSeenAt_ = lastReportAt_;
   // Every 2.5 s (a waiting line every 5 s at most), from the process's one PeriodicCall thread:
   // a manager holds up to thousands of agents, and a roscpp timer each would stall it.
   watch_ = PeriodicCall(nh_.getCallbackQueue(), kReportEvery / 2, [this] { reportWaiting(); });

@@ -317,7 +317,9 @@ class World {
   }
   void agentGotState(int i, const State& s) {
     if (AgentProtocol* a = agents_[static_cast<std::size_t>(i)].get()) {
-      carryOut(i, a->step(AgentProtocol::StateArrived{s.id, std::make_shared<const State>(s)}));
+      // As AgentNode reads its inbox: one Ready, reused (carryOut only queues messages).
+      a->step(AgentProtocol::StateArrived{s.id, std::make_shared<const State>(s)}, readyForStates_);
+      carryOut(i, readyForStates_);
     }
   }
   void agentGotProgress(int i, const Progress& p) {
@@ -462,6 +464,7 @@ class World {
   long window_, markerEvery_;
   std::vector<Positions> expected_;
   std::vector<std::unique_ptr<AgentProtocol>> agents_;
+  AgentProtocol::Ready readyForStates_;  // agentGotState's, reused
   std::map<int, State> latched_;  // each agent's newest published state
   long recalledAgain_ = 0;
   std::optional<Progress> latchedProgress_;

@@ -100,6 +100,74 @@ TEST(Recovery, AnAnswerThatIsNotNewerIsANoteNotADroppedState) {
   EXPECT_EQ(a.agent().step(), 5);
 }
 
+// AgentNode reads its inbox into one Ready that it reuses: whatever an earlier event left in it,
+// each answer must equal the fresh Ready that step(e) returns for the same event.
+TEST(AgentProtocolReady, AReusedReadyAnswersAsAFreshOne) {
+  const Scenario s = shortScenario("hexagon", 24);
+  const auto make = [](const LockstepAgent& c, const std::string&) {
+    return std::make_shared<const State>(State{c.id(), c.step(), c.position(), c.previousPosition()});
+  };
+  AgentProtocol fresh(LockstepAgent(s, 1), make), reused(LockstepAgent(s, 1), make);
+  AgentProtocol::Ready ready;  // every field away from its initial value
+  ready.publish.push_back(std::make_shared<const State>(State{9, 9, {0.0, 0.0}, {0.0, 0.0}}));
+  ready.failed = ready.dropped = ready.note = ready.over = "left over";
+  ready.wakeWhenSensed = ready.recallAgain = true;
+  ready.wakeAfter = 3.0;
+  ready.resumedAt = 7;
+  fresh.start();
+  reused.start();
+  AgentProtocol::ProgressArrived go;
+  go.progress.progress.state = test::Progress::State::Running;
+  go.progress.progress.allowedStep = 2;
+  fresh.step(go);
+  reused.step(go);
+  // The neighbours' states of step 0, one from the wrong sender (dropped) and one twice (a
+  // duplicate, silent); the last completes step 0, so step 1 is published.
+  std::vector<AgentProtocol::StateArrived> events;
+  const std::vector<int> neighbours = fresh.agent().neighbourIds();
+  ASSERT_GE(neighbours.size(), 2u);
+  for (int j : neighbours) {
+    const LockstepAgent n(s, j);
+    events.push_back({j, std::make_shared<const State>(State{j, 0, n.position(), n.previousPosition()})});
+  }
+  events.insert(events.begin() + 1, events.front());  // a duplicate
+  AgentProtocol::StateArrived forged = events.front();
+  forged.topic = neighbours[1];  // agent neighbours[0]'s state on neighbours[1]'s topic
+  events.insert(events.begin() + 2, forged);
+  long published = 0, dropped = 0;
+  for (const AgentProtocol::StateArrived& e : events) {
+    const AgentProtocol::Ready want = fresh.step(e);
+    reused.step(e, ready);
+    ASSERT_EQ(ready.publish.size(), want.publish.size());
+    for (std::size_t k = 0; k < want.publish.size(); ++k) {
+      EXPECT_EQ(ready.publish[k]->step, want.publish[k]->step);
+      EXPECT_EQ(ready.publish[k]->position, want.publish[k]->position);  // bit for bit
+    }
+    EXPECT_EQ(ready.failed, want.failed);
+    EXPECT_EQ(ready.dropped, want.dropped);
+    EXPECT_EQ(ready.note, want.note);
+    EXPECT_EQ(ready.over, want.over);
+    EXPECT_EQ(ready.wakeWhenSensed, want.wakeWhenSensed);
+    EXPECT_EQ(ready.wakeAfter, want.wakeAfter);
+    EXPECT_EQ(ready.recallAgain, want.recallAgain);
+    EXPECT_EQ(ready.resumedAt, want.resumedAt);
+    published += static_cast<long>(want.publish.size());
+    dropped += want.dropped.empty() ? 0 : 1;
+  }
+  EXPECT_EQ(published, 1);  // step 1, once the last neighbour's state came
+  EXPECT_EQ(dropped, 1);    // the forged one
+  EXPECT_EQ(reused.agent().step(), 1);
+  EXPECT_EQ(fresh.agent().step(), 1);
+  ready.clear();
+  const AgentProtocol::Ready initial;
+  EXPECT_TRUE(ready.publish.empty() && ready.failed.empty() && ready.dropped.empty() && ready.note.empty() &&
+              ready.over.empty());
+  EXPECT_EQ(ready.wakeWhenSensed, initial.wakeWhenSensed);
+  EXPECT_EQ(ready.wakeAfter, initial.wakeAfter);
+  EXPECT_EQ(ready.recallAgain, initial.recallAgain);
+  EXPECT_EQ(ready.resumedAt, initial.resumedAt);
+}
+
 TEST(Recovery, MonitorResumesAfterTheNewestProgressHeard) {
   const auto r = protocol::chooseMonitorResume({{true, true, 11, 3}, {true, true, 19, -1}, {false, true, 50, 2}}, 8);
   EXPECT_EQ(r.step, 20);

@@ -18,6 +18,7 @@
 #include "variational_formation_core/protocol/topic_audience.hpp"
 #include "variational_formation/ros/periodic_call.hpp"
 #include "variational_formation/ros/recalled.hpp"
+#include "variational_formation/ros/state_batch.hpp"
 #include "variational_formation_core/agents/lockstep_agent.hpp"
 #include "variational_formation_core/protocol/agent_protocol.hpp"
 
@@ -124,8 +125,9 @@ class AgentNode {
   LocalStates::Exchange* exchange_ = nullptr;  // the manager's, if it hosts this agent
   std::unique_ptr<TopicAudience<AgentState::ConstPtr>> audience_;  // with exchange_: who else needs the topic
   // States of neighbours on this agent's thread, handed over by the exchange (AgentThreads::soon).
-  std::deque<std::pair<int, AgentState::ConstPtr>> inbox_;
+  std::vector<std::pair<int, AgentState::ConstPtr>> inbox_;
   bool inboxRead_ = false;  // a readInbox is due on the thread's lane
+  Protocol::Ready ready_;   // readInbox's, reused (its buffers kept)
   std::vector<ros::Subscriber> subs_;
   std::map<int, std::string> owners_;         // full node names of sources(), by agent id
   std::vector<std::string> managers_;         // ~agent_manager: nodelet managers of agents
@@ -136,11 +138,23 @@ class AgentNode {
   long pacedStep_ = -1;  // the step whose release by the Pacer it waits for (-1: none)
   double realTimeFactor_ = 0.0;
   ros::WallTime lastReportAt_;
+  long stepSeen_ = -1;          // the agent's step at the waiting line's last look
+  ros::WallTime stepSeenAt_;    // when that look saw it move
   long dropped_ = 0;
   std::string name_, frame_, worldFrame_;
   bool sharedBoard_ = false;  // the manager's board (SensingHub), not one of its own
   long wakeStep_ = -1;        // the step a wake-up from the board is asked for
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);  // read by queued wake-ups
+  // readInbox as AgentThreads::soon's task, handed over for every read (no allocation per call);
+  // its node is null once the node is gone, for a read still on the lane.
+  struct InboxReader : AgentThreads::Task {
+    explicit InboxReader(AgentNode* n) : node(n) {}
+    void run() override {
+      if (node) node->readInbox();
+    }
+    AgentNode* node;
+  };
+  std::shared_ptr<InboxReader> inboxReader_ = std::make_shared<InboxReader>(this);
   // The waiting line (not a roscpp timer: one per agent of a manager is costly). Last, so that it
   // stops, and a call in progress ends, before any member it reads goes.
   PeriodicCall watch_;

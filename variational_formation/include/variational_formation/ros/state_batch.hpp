@@ -106,6 +106,14 @@ class AgentThreads {
    * still in the cache (doc/distributed.md, "Local delivery"). Only from one of these threads.
    */
   static void soon(std::function<void()> work);
+  /// Work for soon() that its caller keeps and hands over as often as it likes: held by a shared
+  /// pointer, it costs no allocation per call (a std::function holding one would).
+  struct Task {
+    virtual ~Task() = default;
+    virtual void run() = 0;
+  };
+  /// As soon(work), with `task->run()` as the work.
+  static void soon(std::shared_ptr<Task> task);
   ~AgentThreads();
 
  private:

@@ -24,7 +24,7 @@ namespace vf::protocol {
  * - Flow gate: it computes step k + 1 only while k < the newest allowed step it heard, once it
  *   holds every command the newest progress counts, and never after the run is over or it failed.
  * - Pacing: with a real-time factor r > 0, step k + 1 is due (k + 1 - k0) h / r [s] after the
- *   first step it computed (from k0), on the caller's clock.
+ *   first step it computed (from k0), on the caller's clock (read for pacing only).
  * - Histories: its published states, and the neighbours' states it accepted, after the newest
  *   completed step it heard (served to a restarted monitor or recorder, `~history`).
  * - Failures: a step that is not finite is undone and its last good state published with the
@@ -59,6 +59,19 @@ class AgentProtocol {
     /// Ask the holders again where to resume (as at a restart) and give their answer to step(Recalled).
     bool recallAgain = false;
     long resumedAt = -1;            ///< >= 0: it resumed at this step on a Recalled answer
+
+    /// Back to "nothing to do", keeping the buffers (every field above, as initialised).
+    void clear() {
+      publish.clear();
+      failed.clear();
+      dropped.clear();
+      note.clear();
+      over.clear();
+      wakeWhenSensed = false;
+      wakeAfter = -1.0;
+      recallAgain = false;
+      resumedAt = -1;
+    }
   };
 
   /// A state on agent `topic`'s topic (already checked to come from its owner).
@@ -112,6 +125,12 @@ class AgentProtocol {
     Ready r;
     offer(r, e);
     return r;
+  }
+  /// As step(e), into `r` (cleared first): a caller that keeps one Ready for the states it reads
+  /// allocates nothing per state.
+  void step(const StateArrived& e, Ready& r) {
+    r.clear();
+    offer(r, e);
   }
 
   Ready step(const Recalled& e) {
@@ -239,8 +258,6 @@ class AgentProtocol {
   /// -1 while the run goes on; 0 once the monitor said it finished, 1 failed.
   int exitStatus() const { return exitStatus_; }
   const std::string& failure() const { return failure_; }
-  /// Clock time [s] of the newest step computed; < 0 before any.
-  double lastStepAt() const { return lastStepAt_; }
   long allowedStep() const { return allowedStep_; }
   long commandsHeld() const { return commandsHeld_; }
 
@@ -291,7 +308,8 @@ class AgentProtocol {
         r.wakeWhenSensed = true;
         return;
       }
-      const double now = clock_ ? clock_() : 0.0;
+      // The clock is read for pacing only: unpaced, a step needs no time of day.
+      const double now = realTimeFactor_ > 0.0 && clock_ ? clock_() : 0.0;
       if (!started_) {
         started_ = true;
         startedAt_ = now;
@@ -316,7 +334,6 @@ class AgentProtocol {
         return;
       }
       publishNow(r);
-      lastStepAt_ = now;
     }
   }
   void fail(Ready& r, const std::string& why) {
@@ -352,7 +369,7 @@ class AgentProtocol {
   long commandsHeld_ = 0;     // commands of the monitor's list applied
   long commandsCounted_ = 0;  // commands the newest progress counts: the agent steps only once it holds them
   bool started_ = false;
-  double startedAt_ = 0.0, lastStepAt_ = -1.0;
+  double startedAt_ = 0.0;
   long startStep_ = 0;
   int exitStatus_ = -1;
   std::string failure_;
