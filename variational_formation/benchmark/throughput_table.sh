@@ -14,6 +14,11 @@
 #   first count): 1 is a flat per-agent cost;
 #   ceiling, steps/s and its ratio to R (the ceiling's own flatness: it must be linear too);
 #   lockstep / ceiling.
+# After the table, per count: the agents' own step alone (benchmark_protocol: the shipped
+# AgentProtocol and LockstepAgent of every agent on one thread, states handed straight into the
+# inboxes, no transport), in µs per agent-step, and what it bounds: a lockstep agent-step costs
+# at least its own step plus the ceiling's, so lockstep / ceiling is at most
+# ceiling's µs / (own µs + ceiling's µs).
 # Every run, the lockstep one and the ceiling, takes 1200000 / agents steps, within 1200 to 60000
 # (12000 at 100 agents, about 3 s): long enough that the start (the first status, the connections) is not
 # what is measured. (Until issue 34's last round: 120000 / agents lockstep steps, 0.3 s at 100.)
@@ -37,10 +42,10 @@ rounds="${VF_TABLE_ROUNDS:-3}"
 case "$rounds" in ''|*[!0-9]*|0) echo "throughput_table: VF_TABLE_ROUNDS must be a whole number >= 1, got '$rounds'" >&2; exit 2 ;; esac
 # The median of the numbers given (the lower middle one of an even count); empty if none.
 median() { printf '%s\n' "$@" | grep -E '^[0-9]+$' | sort -n | awk '{ v[NR] = $1 } END { if (NR) print v[int((NR + 1) / 2)] }'; }
-declare -A rate ceiling runs ceilings
+declare -A rate ceiling runs ceilings own owns
 for n in "${counts[@]}"; do
   steps=$(( 1200000 / n > 60000 ? 60000 : (1200000 / n > 1200 ? 1200000 / n : 1200) ))
-  r_all=() c_all=()
+  r_all=() c_all=() o_all=()
   for ((round = 1; round <= rounds; ++round)); do
     r=$(VF_BENCH_STEPS="$steps" VF_BENCH_MODES=nodelet VF_BENCH_PORT_BASE="$port_base" VF_BENCH_PORTS=90 "$REPO/scripts/benchmark_ros.sh" "$n" 2>/dev/null |
         awk -v n="$n" '$1 == n && $2 == "nodelet" { print $4; exit }')
@@ -53,11 +58,14 @@ for n in "${counts[@]}"; do
         sed -nE 's/.* ([0-9]+) steps\/s$/\1/p')
     kill "$master" 2>/dev/null || true
     wait "$master" 2>/dev/null || true
-    r_all+=("${r:-failed}") c_all+=("${c:-failed}")
+    o=$("$WS/devel/lib/variational_formation/benchmark_protocol" --agents "$n" --steps "$steps" 2>/dev/null |
+        sed -nE 's/.* ([0-9.]+) us per agent-step$/\1/p')
+    r_all+=("${r:-failed}") c_all+=("${c:-failed}") o_all+=("${o:-failed}")
   done
   rate[$n]=$(median "${r_all[@]}")
   ceiling[$n]=$(median "${c_all[@]}")
-  runs[$n]="${r_all[*]}" ceilings[$n]="${c_all[*]}"
+  runs[$n]="${r_all[*]}" ceilings[$n]="${c_all[*]}" owns[$n]="${o_all[*]}"
+  own[$n]=$(printf '%s\n' "${o_all[@]}" | grep -E '^[0-9.]+$' | sort -g | awk '{ v[NR] = $1 } END { if (NR) print v[int((NR + 1) / 2)] }')
 done
 reference=${counts[0]}
 for n in "${counts[@]}"; do [ "$n" = 100 ] && reference=100; done
@@ -73,7 +81,14 @@ for n in "${counts[@]}"; do
 done
 echo
 echo "Each figure is the median of $rounds rounds; the rounds, steps/s:"
-for n in "${counts[@]}"; do echo "- $n agents: lockstep ${runs[$n]}; ceiling ${ceilings[$n]}"; done
+for n in "${counts[@]}"; do echo "- $n agents: lockstep ${runs[$n]}; ceiling ${ceilings[$n]}; own step (µs) ${owns[$n]}"; done
+echo
+echo "The agents' own step alone (benchmark_protocol, median µs per agent-step), and the most lockstep / ceiling can be:"
+for n in "${counts[@]}"; do
+  awk -v n="$n" -v o="${own[$n]:-0}" -v c="${ceiling[$n]:-0}" 'BEGIN {
+    if (o > 0 && c > 0) { cu = 1e6 / (c * n); printf "- %s agents: own step %.3f µs, ceiling %.3f µs: lockstep / ceiling <= %.2f\n", n, o, cu, cu / (o + cu) }
+    else printf "- %s agents: n/a (a run failed)\n", n }'
+done
 echo
 # target NAME VALUE THRESHOLD: one line, pass or fail.
 target() {

@@ -158,6 +158,10 @@ install(TARGETS robot_sim RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 # The transport's ceiling for a nodelet run (benchmark/transport_ceiling.sh; the package's own
 # AgentThreads, StateBatch and batch reading from variational_formation_ros), built for the
 # checkout only, like benchmark_roa.
+add_executable(benchmark_protocol benchmark/benchmark_protocol.cpp)
+add_dependencies(benchmark_protocol ${catkin_EXPORTED_TARGETS})
+target_link_libraries(benchmark_protocol variational_formation_tools ${variational_formation_core_LIBRARIES} ${catkin_LIBRARIES})
+target_compile_options(benchmark_protocol PRIVATE ${VF_FLAGS})
 add_executable(benchmark_transport benchmark/benchmark_transport.cpp)
 add_dependencies(benchmark_transport ${catkin_EXPORTED_TARGETS})
 target_link_libraries(benchmark_transport variational_formation_ros ${variational_formation_core_LIBRARIES} ${catkin_LIBRARIES})
