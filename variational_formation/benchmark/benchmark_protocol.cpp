@@ -3,7 +3,7 @@
 // the shipped AgentProtocol around its LockstepAgent, as an agent_manager holds them, with no
 // ROS transport at all. A state goes straight into its neighbours' inboxes, read as
 // AgentThreads' lane reads them (the agent last handed a state reads first). The state messages
-// are variational_formation_msgs AgentState, reused once nothing holds them (the scheme of
+// are variational_formation_msgs AgentState, reused once nothing holds them (ReusedMessages, as
 // AgentNode::makeState). Progress goes to every agent each quarter window, with the allowed step
 // a window ahead of the completed one (as the monitor's), and trims the histories. What the
 // transport adds (the hand-over between agents, the batches, the monitor's process) is
@@ -13,17 +13,15 @@
 // Prints the steps per second and the µs per agent-step, from the first step to the last.
 #include <chrono>
 #include <cstdio>
-#include <deque>
 #include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include <boost/make_shared.hpp>
-
 #include "variational_formation_core/agents/lockstep_agent.hpp"
 #include "variational_formation_core/model/scenario.hpp"
 #include "variational_formation_core/protocol/agent_protocol.hpp"
+#include "variational_formation/ros/reused_messages.hpp"
 #include "variational_formation/tools/make_scenario_cli.hpp"
 #include "variational_formation_msgs/AgentState.h"
 #include "variational_formation_msgs/RunProgress.h"
@@ -37,22 +35,14 @@ using Protocol = vf::protocol::AgentProtocol<StatePtr, variational_formation_msg
 /// One agent: its protocol, its own messages for reuse, and its inbox (as AgentNode's).
 struct Agent {
   std::unique_ptr<Protocol> protocol;
-  std::deque<AgentState::Ptr> made;
+  vf::ReusedMessages<AgentState> made{128};  // as AgentNode's
   std::vector<StatePtr> inbox;  // read oldest first
   bool inboxRead = false;       // a read is on the lane
   Protocol::Ready ready;        // reused, as AgentNode's inbox reads
 };
 
-StatePtr makeState(std::deque<AgentState::Ptr>& made, const vf::LockstepAgent& a, const std::string& failure) {
-  AgentState::Ptr state;
-  if (!made.empty() && made.front().use_count() == 1) {
-    state = std::move(made.front());
-    made.pop_front();
-  } else {
-    state = boost::make_shared<AgentState>();
-  }
-  made.push_back(state);
-  if (made.size() > 128) made.pop_front();
+StatePtr makeState(vf::ReusedMessages<AgentState>& made, const vf::LockstepAgent& a, const std::string& failure) {
+  const AgentState::Ptr state = made.next();
   AgentState& msg = *state;
   msg.header.stamp.fromSec(a.time());
   msg.header.frame_id = "world";
@@ -114,7 +104,7 @@ int main(int argc, char** argv) {
 
   std::vector<Agent> all(static_cast<std::size_t>(n));
   for (long i = 0; i < n; ++i) {
-    std::deque<AgentState::Ptr>& made = all[static_cast<std::size_t>(i)].made;
+    vf::ReusedMessages<AgentState>& made = all[static_cast<std::size_t>(i)].made;
     all[static_cast<std::size_t>(i)].protocol = std::make_unique<Protocol>(
         vf::LockstepAgent(scenario, formation, static_cast<int>(i), vf::StartMethod::Variational, nullptr),
         [&made](const vf::LockstepAgent& a, const std::string& failure) { return makeState(made, a, failure); });

@@ -28,7 +28,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
@@ -46,6 +45,7 @@
 #include "variational_formation_core/protocol/local_exchange.hpp"
 #include "variational_formation_core/protocol/topic_audience.hpp"
 #include "variational_formation/ros/pacer.hpp"
+#include "variational_formation/ros/reused_messages.hpp"
 #include "variational_formation/ros/state_batch.hpp"
 
 namespace {
@@ -62,9 +62,9 @@ struct Agent {
   long step = 0;
   // --delivery manager: neighbours' states handed over on the agents' thread, and this agent's
   // messages, reused once nothing else holds them.
-  std::deque<std::pair<std::size_t, AgentState::ConstPtr>> inbox;
+  std::vector<std::pair<std::size_t, AgentState::ConstPtr>> inbox;
   bool inboxRead = false;
-  std::deque<AgentState::Ptr> made;
+  vf::ReusedMessages<AgentState> made{16};
   long allowed = 0;  // the flow window's end: this agent computes step k only while k <= allowed
 };
 
@@ -89,17 +89,7 @@ struct Bench {
 
   void publish(int i) {
     Agent& a = agents[static_cast<std::size_t>(i)];
-    AgentState::Ptr msg;
-    if (manager && !a.made.empty() && a.made.front().use_count() == 1) {
-      msg = std::move(a.made.front());
-      a.made.pop_front();
-    } else {
-      msg = boost::make_shared<AgentState>();
-    }
-    if (manager) {
-      a.made.push_back(msg);
-      if (a.made.size() > 16) a.made.pop_front();
-    }
+    const AgentState::Ptr msg = manager ? a.made.next() : boost::make_shared<AgentState>();
     msg->id = static_cast<uint32_t>(i);
     msg->step = a.step;
     msg->position = {1.0 * i, 0.5 * a.step};
@@ -170,11 +160,11 @@ struct Bench {
   void readInbox(int i) {
     Agent& a = agents[static_cast<std::size_t>(i)];
     a.inboxRead = false;
-    while (!a.inbox.empty()) {
-      const std::pair<std::size_t, AgentState::ConstPtr> arrived = std::move(a.inbox.front());
-      a.inbox.pop_front();
+    for (std::size_t k = 0; k < a.inbox.size(); ++k) {  // by index, as AgentNode::readInbox
+      const std::pair<std::size_t, AgentState::ConstPtr> arrived = std::move(a.inbox[k]);
       onNeighbour(i, arrived.first, arrived.second);
     }
+    a.inbox.clear();
   }
 };
 }  // namespace

@@ -21,7 +21,6 @@ namespace vf {
 
 namespace {
 constexpr double kReportEvery = 5.0;  // seconds between "waiting for ..." lines
-constexpr std::size_t kMadeKept = 128;  // own state messages kept for reuse, at most
 
 }  // namespace
 
@@ -165,18 +164,8 @@ void AgentNode::onProgress(const ros::MessageEvent<RunProgress const>& event) {
 
 AgentState::ConstPtr AgentNode::makeState(const LockstepAgent& a, const std::string& failure) const {
   // Built once and published as a pointer to const: subscribers in the same process (nodelets in
-  // one manager) receive this very object, without a copy or serialisation. Nothing else holds
-  // a message whose use count is 1, and nothing can take it again: it is safe to reuse.
-  AgentStatePtr state;
-  if (!made_.empty() && made_.front().use_count() == 1) {
-    state = std::move(made_.front());
-    made_.pop_front();
-  } else {
-    state = boost::make_shared<AgentState>();
-  }
-  made_.push_back(state);
-  // Held longer than this (a stalled monitor), the oldest is left to its holders.
-  if (made_.size() > kMadeKept) made_.pop_front();
+  // one manager) receive this very object, without a copy or serialisation (ReusedMessages).
+  const AgentStatePtr state = made_.next();
   AgentState& msg = *state;
   msg.header.stamp.fromSec(a.time());
   msg.header.frame_id = worldFrame_;

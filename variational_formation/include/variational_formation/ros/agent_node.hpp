@@ -18,6 +18,7 @@
 #include "variational_formation_core/protocol/topic_audience.hpp"
 #include "variational_formation/ros/periodic_call.hpp"
 #include "variational_formation/ros/recalled.hpp"
+#include "variational_formation/ros/reused_messages.hpp"
 #include "variational_formation/ros/state_batch.hpp"
 #include "variational_formation_core/agents/lockstep_agent.hpp"
 #include "variational_formation_core/protocol/agent_protocol.hpp"
@@ -117,10 +118,10 @@ class AgentNode {
 
   ros::NodeHandle nh_;
   std::unique_ptr<Protocol> protocol_;
-  // Its own state messages, oldest first (makeState): the oldest, once nothing else holds it (its
-  // step is out of every history, queue and latch), is assigned over for the next state, its
-  // vectors keeping their memory, instead of freeing one message and allocating another.
-  mutable std::deque<AgentStatePtr> made_;
+  // Its own state messages (makeState): the oldest, once nothing else holds it (its step is out
+  // of every history, queue and latch), is filled again for the next state. Held longer than 128
+  // states (a stalled monitor), the oldest is left to its holders.
+  mutable ReusedMessages<AgentState> made_{128};
   ros::Publisher statePub_;
   LocalStates::Exchange* exchange_ = nullptr;  // the manager's, if it hosts this agent
   std::unique_ptr<TopicAudience<AgentState::ConstPtr>> audience_;  // with exchange_: who else needs the topic
