@@ -66,6 +66,8 @@ bool readLong(const char* text, long& value) {
   }
 }
 
+int run(long n, long steps, long window);
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -87,10 +89,21 @@ int main(int argc, char** argv) {
     }
     ++k;
   }
-  if (n < 5 || steps < 1 || window < 4) {
-    std::fprintf(stderr, "benchmark_protocol: needs --agents >= 5, --steps >= 1 and --window >= 4\n");
+  if (n < 5 || n > 100000 || steps < 1 || steps > 100000000 || window < 4 || window > 1000000) {
+    std::fprintf(stderr, "benchmark_protocol: needs --agents in [5, 100000], --steps in [1, 1e8] and --window in [4, 1e6]\n");
     return 2;
   }
+  try {
+    return run(n, steps, window);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "benchmark_protocol: %s\n", e.what());
+    return 1;
+  }
+}
+
+namespace {
+
+int run(long n, long steps, long window) {
   std::ostringstream yaml, err;
   const std::string agents = std::to_string(n), count = std::to_string(steps);
   const char* args[] = {"make_scenario", "--shape", "ring", "--agents", agents.c_str(), "--perturb", "0.05",
@@ -173,3 +186,5 @@ int main(int argc, char** argv) {
               n, steps, window, seconds, static_cast<double>(steps) / seconds, 1e6 * seconds / agentSteps);
   return 0;
 }
+
+}  // namespace
