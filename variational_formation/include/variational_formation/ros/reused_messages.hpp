@@ -3,8 +3,7 @@
 #include <cstddef>
 #include <deque>
 
-#include <boost/make_shared.hpp>
-#include <boost/shared_ptr.hpp>
+#include <ros/ros.h>  // boost::shared_ptr and boost::make_shared, as roscpp's messages use them
 
 namespace vf {
 
