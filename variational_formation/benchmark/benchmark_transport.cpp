@@ -54,6 +54,13 @@ using variational_formation_msgs::AgentStates;
 
 using Exchange = vf::LocalExchange<AgentState::ConstPtr>;
 
+/// A call as AgentThreads' task, made once per agent.
+struct Reader : vf::AgentThreads::Task {
+  explicit Reader(std::function<void()> c) : call(std::move(c)) {}
+  void run() override { call(); }
+  std::function<void()> call;
+};
+
 struct Agent {
   ros::Publisher pub;
   std::unique_ptr<vf::TopicAudience<AgentState::ConstPtr>> audience;  // --delivery local
@@ -64,6 +71,7 @@ struct Agent {
   // messages, reused once nothing else holds them.
   std::vector<std::pair<std::size_t, AgentState::ConstPtr>> inbox;
   bool inboxRead = false;
+  std::shared_ptr<vf::AgentThreads::Task> reader;  // readInbox on the lane, as AgentNode's
   vf::ReusedMessages<AgentState> made{16};
   long allowed = 0;  // the flow window's end: this agent computes step k only while k <= allowed
 };
@@ -143,6 +151,8 @@ struct Bench {
   /// --delivery manager: agent i hears its k-th neighbour as AgentNode::listenLocally does: on
   /// the agents' thread into its inbox, read right after; from any other thread, a call on its queue.
   void listenAsManager(int i, std::size_t k) {
+    Agent& own = agents[static_cast<std::size_t>(i)];
+    if (!own.reader) own.reader = std::make_shared<Reader>([this, i] { readInbox(i); });
     exchange->listen(agents[static_cast<std::size_t>(i)].neighbours[k], static_cast<std::uintptr_t>(i),
                      [this, i, k](int, const AgentState::ConstPtr& m) {
                        Agent& a = agents[static_cast<std::size_t>(i)];
@@ -150,7 +160,7 @@ struct Bench {
                          a.inbox.emplace_back(k, m);
                          if (!a.inboxRead) {
                            a.inboxRead = true;
-                           vf::AgentThreads::soon([this, i] { readInbox(i); });
+                           vf::AgentThreads::soon(a.reader);
                          }
                          return;
                        }

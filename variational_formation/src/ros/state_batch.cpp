@@ -131,18 +131,12 @@ namespace {
 std::unique_ptr<AgentThreads> gThreads;  // this process's, if it is an agent manager
 constexpr int kLaneBurst = 64;           // soon() calls run between two looks at the queue
 thread_local const ros::CallbackQueueInterface* tServed = nullptr;  // the queue this thread serves
-struct LaneEntry {  // one of the two: soon(work) or soon(task)
-  std::function<void()> work;
-  std::shared_ptr<AgentThreads::Task> task;
-};
-thread_local std::vector<LaneEntry> tLane;  // soon(): newest last
+thread_local std::vector<std::shared_ptr<AgentThreads::Task>> tLane;  // soon(): newest last
 }  // namespace
 
 bool AgentThreads::serves(const ros::CallbackQueueInterface* queue) { return queue != nullptr && tServed == queue; }
 
-void AgentThreads::soon(std::function<void()> work) { tLane.push_back(LaneEntry{std::move(work), nullptr}); }
-
-void AgentThreads::soon(std::shared_ptr<Task> task) { tLane.push_back(LaneEntry{std::function<void()>(), std::move(task)}); }
+void AgentThreads::soon(std::shared_ptr<Task> task) { tLane.push_back(std::move(task)); }
 
 void AgentThreads::start(int threads, std::size_t agents) { gThreads.reset(new AgentThreads(threads, agents)); }
 
@@ -159,13 +153,9 @@ AgentThreads::AgentThreads(int threads, std::size_t agents) : agents_(agents) {
         // With work of its own waiting, only a look at the queue; else wait for a callback.
         queue->callAvailable(tLane.empty() ? ros::WallDuration(0.1) : ros::WallDuration());
         for (int k = 0; k < kLaneBurst && !tLane.empty() && !stopping_; ++k) {
-          const LaneEntry next = std::move(tLane.back());
+          const std::shared_ptr<Task> next = std::move(tLane.back());
           tLane.pop_back();
-          if (next.task) {
-            next.task->run();
-          } else {
-            next.work();
-          }
+          next->run();
         }
       }
       tLane.clear();

@@ -99,20 +99,18 @@ class AgentThreads {
   ros::CallbackQueue* nextQueue();
   /// Whether the calling thread is the one that serves `queue`.
   static bool serves(const ros::CallbackQueueInterface* queue);
-  /**
-   * Runs `work` on the calling thread (one of these threads) after the callback that adds it, the
-   * newest added first, ahead of the queue's later callbacks but interleaved with them (64 at a
-   * time): a state handed from one agent to a neighbour on the same thread is read while it is
-   * still in the cache (doc/distributed.md, "Local delivery"). Only from one of these threads.
-   */
-  static void soon(std::function<void()> work);
-  /// Work for soon() that its caller keeps and hands over as often as it likes: held by a shared
+  /// Work for soon(), kept by its caller and handed over as often as it likes: held by a shared
   /// pointer, it costs no allocation per call (a std::function holding one would).
   struct Task {
     virtual ~Task() = default;
     virtual void run() = 0;
   };
-  /// As soon(work), with `task->run()` as the work.
+  /**
+   * Runs `task->run()` on the calling thread (one of these threads) after the callback that adds
+   * it, the newest added first, ahead of the queue's later callbacks but interleaved with them (64
+   * at a time): a state handed from one agent to a neighbour on the same thread is read while it
+   * is still in the cache (doc/distributed.md, "Local delivery"). Only from one of these threads.
+   */
   static void soon(std::shared_ptr<Task> task);
   ~AgentThreads();
 
