@@ -3,9 +3,10 @@
 # targets), printed as two Markdown tables. Every run is scripts/benchmark_ros.sh's (a ring with
 # chords to the second neighbour, all agents in one manager, nodelet:=true, its own ROS master).
 #
-# Recording, per agent count of VF_RP_RECORD (default "100 1000"), h = 0.005 s: the same
-# scenario unrecorded, then recorded (record:=true, no size limit) and compared with simulate by
-# benchmark/bag_vs_simulate.py. Target: recorded steps/s >= 0.5 x unrecorded, exact.
+# Recording, per agent count of VF_RP_RECORD (default "100 1000"), h = 0.005 s, max(1200,
+# 1.2e6 / agents) steps (VF_BENCH_STEPS overrides): the same scenario unrecorded, then recorded
+# (record:=true, no size limit) and compared with simulate by benchmark/bag_vs_simulate.py.
+# Target: recorded steps/s >= 0.5 x unrecorded, exact.
 #
 # Pacing, per agent count of VF_RP_PACE (default "100 500"): an unpaced run at h = 0.005 s gives
 # its rate R0; the time step is then chosen so that real time needs R0 / VF_RP_MARGIN steps/s
@@ -15,8 +16,9 @@
 # (from step 0 to the last step) is >= 0.98.
 #
 # usage: benchmark/recording_pacing.sh
-# environment: VF_RP_RECORD, VF_RP_PACE, VF_RP_MARGIN as above; VF_BENCH_STEPS (steps per run,
-#   default benchmark_ros.sh's max(600, 120000 / agents)); masters on ports 11600-11699
+# environment: VF_RP_RECORD, VF_RP_PACE, VF_RP_MARGIN as above; VF_BENCH_STEPS (steps per
+#   recording run, default as above); VF_BENCH_ARGS (more formation.launch arguments, e.g.
+#   "record_compression:=none"); masters on ports 11600-11699
 #   (VF_BENCH_PORT_BASE, VF_BENCH_PORTS).
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -39,8 +41,11 @@ echo
 echo "| agents | unrecorded steps/s | recorded steps/s | recorded / unrecorded (>= 0.5) | exact |"
 echo "| --- | --- | --- | --- | --- |"
 for n in "${record_counts[@]}"; do
-  plain=$(run "$n" || echo "$n - - n/a")
-  recorded=$(VF_BENCH_RECORD=1 run "$n" || echo "$n - - n/a - - - - no")
+  # Runs of a few seconds (benchmark_ros.sh's default lasts 0.1 s unrecorded at 100 agents on a
+  # fast machine, too short for a ratio): max(1200, 1.2e6 / agents) steps unless VF_BENCH_STEPS.
+  steps=${VF_BENCH_STEPS:-$(( n > 0 && 1200000 / n > 1200 ? 1200000 / n : 1200 ))}
+  plain=$(VF_BENCH_STEPS=$steps run "$n" || echo "$n - - n/a")
+  recorded=$(VF_BENCH_STEPS=$steps VF_BENCH_RECORD=1 run "$n" || echo "$n - - n/a - - - - no")
   echo "| $n | $(field "$plain" 4) | $(field "$recorded" 4) | $(ratio "$(field "$recorded" 4)" "$(field "$plain" 4)") | $(field "$recorded" 9) |"
 done
 echo

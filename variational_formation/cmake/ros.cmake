@@ -3,6 +3,7 @@ add_library(variational_formation_ros
   src/ros/agent_commands.cpp
   src/ros/agent_node.cpp
   src/ros/agent_recovery.cpp
+  src/ros/bag_writer.cpp
   src/ros/formation_subscriptions.cpp
   src/ros/frame_broadcaster.cpp
   src/ros/frames.cpp
@@ -94,6 +95,10 @@ if(CATKIN_ENABLE_TESTING)
   catkin_add_gtest(test_markers test/ros/test_markers.cpp)
   target_link_libraries(test_markers variational_formation_ros gtest_main)
   target_compile_options(test_markers PRIVATE ${VF_FLAGS})
+  # The recorder's bag writer, read back by rosbag (no master).
+  catkin_add_gtest(test_bag_writer test/ros/test_bag_writer.cpp)
+  target_link_libraries(test_bag_writer variational_formation_ros gtest_main)
+  target_compile_options(test_bag_writer PRIVATE ${VF_FLAGS})
   # The bounded pool of service calls (no master).
   catkin_add_gtest(test_call_pool test/ros/test_call_pool.cpp)
   target_link_libraries(test_call_pool variational_formation_ros gtest_main)

@@ -23,23 +23,19 @@ void RecorderNode::openPart() {
     path = stem + "_" + std::to_string(part_) + ".bag";
   }
   try {
-    bag_.open(path, rosbag::bagmode::Write);
-    // LZ4 chunks: rosbag seeks to the file's end before each message, and on an uncompressed bag
-    // that flushed and re-read the file's tail (five system calls a message, most of the
-    // recorder's time at 100 agents: doc/benchmarks.md); a compressed chunk goes out whole.
-    bag_.setCompression(rosbag::compression::LZ4);
-    // The file grows a chunk at a time: chunks of at most an eighth of the limits keep the parts
-    // within them (rosbag's default is 768 kB).
+    // Chunks written whole (BagWriter), LZ4 or plain (~compression). The file grows a chunk at a
+    // time: chunks of at most an eighth of the limits keep the parts within them (rosbag's
+    // default is 768 kB).
     const double limit = std::min(splitBytes_ > 0.0 ? splitBytes_ : HUGE_VAL, maxBytes_ > 0.0 ? maxBytes_ : HUGE_VAL);
-    bag_.setChunkThreshold(static_cast<uint32_t>(std::clamp(limit / 8.0, 16e3, 768e3)));
+    bag_.open(path, compression_, static_cast<uint32_t>(std::clamp(limit / 8.0, 16e3, 768e3)));
     open_ = true;
   } catch (const std::exception& e) {
-    throw InvalidInput("~bag: cannot write '" + path + "': " + e.what());
+    throw InvalidInput(std::string("~bag: cannot write ") + e.what());
   }
 }
 
 void RecorderNode::enforceLimits() {
-  const double size = static_cast<double>(bag_.getSize());
+  const double size = static_cast<double>(bag_.size());
   if (maxBytes_ > 0.0 && closedBytes_ + size >= maxBytes_) {
     limited_ = true;
     ROS_WARN("recorder: the size limit of %.0f MB ends the recording (%d files); the run goes on", maxBytes_ / 1e6,
@@ -65,7 +61,7 @@ void RecorderNode::write(const std::string& topic, const M& msg, const ros::Time
     ++written_;
     enforceLimits();
   } catch (const std::exception& e) {
-    fail(std::string("cannot write ") + path_ + ": " + e.what());
+    fail(std::string("cannot write ") + e.what());
   }
 }
 

@@ -41,6 +41,11 @@ RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) 
   const double maxMb = optionalParam(pnh, "max_size", 1024.0);
   if (!(splitMb >= 0.0 && splitMb < 1e9)) throw InvalidInput("~split_size: must be in [0, 1e9) MB, got " + std::to_string(splitMb));
   if (!(maxMb >= 0.0 && maxMb < 1e9)) throw InvalidInput("~max_size: must be in [0, 1e9) MB, got " + std::to_string(maxMb));
+  const std::string compression = optionalParam<std::string>(pnh, "compression", "lz4");
+  if (compression != "lz4" && compression != "none") {
+    throw InvalidInput("~compression: must be lz4 or none, got '" + compression + "'");
+  }
+  compression_ = compression == "lz4" ? BagWriter::Compression::Lz4 : BagWriter::Compression::None;
   splitBytes_ = splitMb * 1e6;
   maxBytes_ = maxMb * 1e6;
   createParentDirectory(path_, "~bag");

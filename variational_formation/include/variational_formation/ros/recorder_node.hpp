@@ -5,9 +5,9 @@
 #include <vector>
 
 #include <ros/ros.h>
-#include <rosbag/bag.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "variational_formation/ros/bag_writer.hpp"
 #include "variational_formation/ros/state_batch.hpp"
 #include "variational_formation_msgs/AgentState.h"
 #include "variational_formation_msgs/FormationCommands.h"
@@ -94,7 +94,8 @@ class RecorderNode {
   void writeCommandsFile() const;
 
   ros::NodeHandle nh_;
-  rosbag::Bag bag_;
+  BagWriter bag_;
+  BagWriter::Compression compression_ = BagWriter::Compression::Lz4;  // ~compression
   std::string path_, monitor_, statusTopic_, markersTopic_, commandsTopic_;
   std::vector<std::string> stateTopics_, frameIds_;  // by agent
   std::vector<ros::Subscriber> subs_;

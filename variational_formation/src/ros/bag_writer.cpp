@@ -1,0 +1,257 @@
+// Our own writer of ROS bags, format 2.0 (bag_writer.hpp): the records rosbag writes, chunk by
+// chunk, with no seek before each message.
+#include "variational_formation/ros/bag_writer.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+
+#include <roslz4/lz4s.h>
+
+namespace vf {
+
+namespace {
+
+constexpr char kVersionLine[] = "#ROSBAG V2.0\n";
+constexpr std::uint8_t kOpMessageData = 0x02, kOpFileHeader = 0x03, kOpIndexData = 0x04, kOpChunk = 0x05,
+                       kOpChunkInfo = 0x06, kOpConnection = 0x07;
+constexpr std::uint32_t kFileHeaderLength = 4096;  // the file header record's header and padding
+constexpr std::uint32_t kIndexVersion = 1, kChunkInfoVersion = 1;
+constexpr int kLz4BlockSizeId = 6;  // rosbag's
+
+void append(std::vector<std::uint8_t>& out, const void* bytes, std::size_t count) {
+  const auto* b = static_cast<const std::uint8_t*>(bytes);
+  out.insert(out.end(), b, b + count);
+}
+void appendU32(std::vector<std::uint8_t>& out, std::uint32_t v) { append(out, &v, 4); }
+void appendTime(std::vector<std::uint8_t>& out, const ros::Time& t) {
+  appendU32(out, t.sec);
+  appendU32(out, t.nsec);
+}
+
+/// A record's header (or a connection header): fields "name=value", each after its length.
+class Fields {
+ public:
+  explicit Fields(std::vector<std::uint8_t>& out) : out_(out), start_(out.size()) { appendU32(out_, 0); }
+  Fields& bytes(const char* name, const void* value, std::size_t count) {
+    const std::size_t n = std::strlen(name);
+    appendU32(out_, static_cast<std::uint32_t>(n + 1 + count));
+    append(out_, name, n);
+    out_.push_back('=');
+    append(out_, value, count);
+    return *this;
+  }
+  Fields& op(std::uint8_t v) { return bytes("op", &v, 1); }
+  Fields& u32(const char* name, std::uint32_t v) { return bytes(name, &v, 4); }
+  Fields& u64(const char* name, std::uint64_t v) { return bytes(name, &v, 8); }
+  Fields& time(const char* name, const ros::Time& t) {
+    const std::uint32_t v[2] = {t.sec, t.nsec};
+    return bytes(name, v, 8);
+  }
+  Fields& text(const char* name, const std::string& v) { return bytes(name, v.data(), v.size()); }
+  /// Writes the header's length in front of it; @return that length.
+  std::uint32_t done() {
+    const auto length = static_cast<std::uint32_t>(out_.size() - start_ - 4);
+    std::memcpy(out_.data() + start_, &length, 4);
+    return length;
+  }
+
+ private:
+  std::vector<std::uint8_t>& out_;
+  std::size_t start_;
+};
+
+}  // namespace
+
+BagWriter::~BagWriter() {
+  if (!isOpen()) return;
+  try {
+    close();
+  } catch (const std::exception& e) {
+    ROS_ERROR("%s", e.what());
+  }
+}
+
+void BagWriter::failed(const std::string& what) const {
+  throw std::runtime_error((path_.empty() ? std::string("bag") : path_) + ": " + what);
+}
+
+void BagWriter::open(const std::string& path, Compression compression, std::uint32_t chunkBytes,
+                     double chunkSeconds) {
+  if (isOpen()) failed("already open (writing " + path_ + ")");
+  path_ = path;
+  file_ = std::fopen(path.c_str(), "wb");
+  if (file_ == nullptr) failed(std::strerror(errno));
+  compression_ = compression;
+  chunkBytes_ = std::max<std::uint32_t>(chunkBytes, 1);
+  chunkAge_ = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(std::max(chunkSeconds, 0.0)));
+  chunkMessages_ = 0;
+  fileBytes_ = 0;
+  connections_.clear();
+  byTopic_.clear();
+  index_.clear();
+  chunkConnections_.clear();
+  chunks_.clear();
+  chunk_.clear();
+  chunk_.reserve(chunkBytes_ + 64 * 1024);
+  put(kVersionLine, sizeof(kVersionLine) - 1);
+  writeFileHeader(0);  // rewritten at close with the index's position and the counts
+}
+
+void BagWriter::writeFileHeader(std::uint64_t indexPosition) {
+  record_.clear();
+  const std::uint32_t length = Fields(record_)
+                                   .op(kOpFileHeader)
+                                   .u64("index_pos", indexPosition)
+                                   .u32("conn_count", static_cast<std::uint32_t>(connections_.size()))
+                                   .u32("chunk_count", static_cast<std::uint32_t>(chunks_.size()))
+                                   .done();
+  const std::uint32_t padding = length < kFileHeaderLength ? kFileHeaderLength - length : 0;
+  appendU32(record_, padding);
+  record_.insert(record_.end(), padding, ' ');
+  put(record_.data(), record_.size());
+}
+
+std::uint32_t BagWriter::connection(const std::string& topic, const char* type, const char* md5sum,
+                                    const char* definition) {
+  const auto found = byTopic_.find(topic);
+  if (found != byTopic_.end()) {
+    const Connection& c = connections_[found->second];
+    if (c.type != type) failed("topic " + topic + " was written as " + c.type + ", now as " + type);
+    return found->second;
+  }
+  const auto id = static_cast<std::uint32_t>(connections_.size());
+  connections_.push_back(Connection{topic, type, md5sum, definition});
+  byTopic_.emplace(topic, id);
+  index_.emplace_back();
+  // Its connection record goes into the chunk that holds its first message, as rosbag does (so
+  // `rosbag reindex` finds it), and again with the index at the end.
+  const Connection& c = connections_.back();
+  Fields(chunk_).op(kOpConnection).u32("conn", id).text("topic", c.topic).done();
+  Fields(chunk_).text("topic", c.topic).text("type", c.type).text("md5sum", c.md5sum)
+      .text("message_definition", c.definition).done();
+  return id;
+}
+
+std::uint8_t* BagWriter::beginMessage(const std::string& topic, const char* type, const char* md5sum,
+                                      const char* definition, const ros::Time& time, std::uint32_t length) {
+  if (!isOpen()) failed("not open");
+  if (time < ros::TIME_MIN) failed("a message on " + topic + " at time 0 (a bag's times start at 1 ns)");
+  const std::uint32_t conn = connection(topic, type, md5sum, definition);
+  if (chunkConnections_.empty()) {
+    chunkStart_ = chunkEnd_ = time;
+    chunkOpened_ = std::chrono::steady_clock::now();
+  }
+  ++chunkMessages_;
+  if (index_[conn].empty()) chunkConnections_.push_back(conn);
+  index_[conn].push_back(IndexEntry{time, static_cast<std::uint32_t>(chunk_.size())});
+  if (time < chunkStart_) chunkStart_ = time;
+  if (time > chunkEnd_) chunkEnd_ = time;
+  Fields(chunk_).op(kOpMessageData).u32("conn", conn).time("time", time).done();
+  appendU32(chunk_, length);
+  const std::size_t at = chunk_.size();
+  chunk_.resize(at + length);
+  return chunk_.data() + at;
+}
+
+void BagWriter::endMessage() {
+  if (chunk_.size() >= chunkBytes_ ||
+      (chunkMessages_ % 64 == 0 && std::chrono::steady_clock::now() - chunkOpened_ >= chunkAge_)) {
+    writeChunk();
+  }
+}
+
+void BagWriter::writeChunk() {
+  if (chunkConnections_.empty()) return;
+  const auto size = static_cast<std::uint32_t>(chunk_.size());
+  const char* data = reinterpret_cast<const char*>(chunk_.data());
+  std::uint32_t dataLength = size;
+  std::string method = "none";
+  if (compression_ == Compression::Lz4) {
+    compressed_.resize(size + size / 128 + 1024);
+    unsigned int out = static_cast<unsigned int>(compressed_.size());
+    // An incompressible chunk that outgrows the buffer is written as it is ("none").
+    if (roslz4_buffToBuffCompress(reinterpret_cast<char*>(chunk_.data()), size, compressed_.data(), &out,
+                                  kLz4BlockSizeId) == ROSLZ4_OK) {
+      data = compressed_.data();
+      dataLength = out;
+      method = "lz4";
+    }
+  }
+  ChunkInfo info;
+  info.position = fileBytes_;
+  info.start = chunkStart_;
+  info.end = chunkEnd_;
+  record_.clear();
+  Fields(record_).op(kOpChunk).text("compression", method).u32("size", size).done();
+  appendU32(record_, dataLength);
+  put(record_.data(), record_.size());
+  put(data, dataLength);
+  // One index data record per connection in the chunk: (time, offset in the chunk) per message.
+  record_.clear();
+  for (const std::uint32_t conn : chunkConnections_) {
+    std::vector<IndexEntry>& entries = index_[conn];
+    const auto count = static_cast<std::uint32_t>(entries.size());
+    Fields(record_).op(kOpIndexData).u32("ver", kIndexVersion).u32("conn", conn).u32("count", count).done();
+    appendU32(record_, count * 12);
+    for (const IndexEntry& e : entries) {
+      appendTime(record_, e.time);
+      appendU32(record_, e.offset);
+    }
+    info.counts.emplace_back(conn, count);
+    entries.clear();
+  }
+  put(record_.data(), record_.size());
+  // Into the file now: a writer killed later loses only the chunk it was filling.
+  if (std::fflush(file_) != 0) failed(std::strerror(errno));
+  chunks_.push_back(std::move(info));
+  chunkConnections_.clear();
+  chunk_.clear();
+  chunkMessages_ = 0;
+}
+
+void BagWriter::close() {
+  if (!isOpen()) return;
+  try {
+    writeChunk();
+    const std::uint64_t indexPosition = fileBytes_;
+    record_.clear();
+    for (std::uint32_t id = 0; id < connections_.size(); ++id) {
+      const Connection& c = connections_[id];
+      Fields(record_).op(kOpConnection).u32("conn", id).text("topic", c.topic).done();
+      Fields(record_).text("topic", c.topic).text("type", c.type).text("md5sum", c.md5sum)
+          .text("message_definition", c.definition).done();
+    }
+    for (const ChunkInfo& info : chunks_) {
+      const auto count = static_cast<std::uint32_t>(info.counts.size());
+      Fields(record_).op(kOpChunkInfo).u32("ver", kChunkInfoVersion).u64("chunk_pos", info.position)
+          .time("start_time", info.start).time("end_time", info.end).u32("count", count).done();
+      appendU32(record_, count * 8);
+      for (const auto& [conn, messages] : info.counts) {
+        appendU32(record_, conn);
+        appendU32(record_, messages);
+      }
+    }
+    put(record_.data(), record_.size());
+    if (std::fseek(file_, sizeof(kVersionLine) - 1, SEEK_SET) != 0) failed(std::strerror(errno));
+    const std::uint64_t end = fileBytes_;
+    writeFileHeader(indexPosition);
+    fileBytes_ = end;
+  } catch (...) {
+    std::fclose(file_);
+    file_ = nullptr;
+    throw;
+  }
+  const int closed = std::fclose(file_);
+  file_ = nullptr;
+  if (closed != 0) failed(std::strerror(errno));
+}
+
+void BagWriter::put(const void* bytes, std::size_t count) {
+  if (count > 0 && std::fwrite(bytes, 1, count, file_) != count) failed(std::strerror(errno));
+  fileBytes_ += count;
+}
+
+}  // namespace vf

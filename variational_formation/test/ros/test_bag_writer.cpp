@@ -1,0 +1,206 @@
+// The recorder's bag writer (src/ros/bag_writer.cpp), read back by rosbag's own C++ reader: every
+// message, topic, time, type and definition as written, through the index (by topic and by time),
+// compressed or not, in one chunk or many; and a bad use is one line naming the file.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <std_msgs/String.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include "variational_formation/ros/bag_writer.hpp"
+#include "variational_formation_msgs/AgentState.h"
+
+namespace vf {
+namespace {
+
+using variational_formation_msgs::AgentState;
+namespace fs = std::filesystem;
+
+struct Written {
+  std::string topic;
+  ros::Time time;
+  AgentState state;  // for the agents' topics
+  std::string text;  // for /text
+};
+
+class BagWriterTest : public ::testing::TestWithParam<std::tuple<BagWriter::Compression, std::uint32_t>> {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("vf_bag_writer_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+  /// `steps` steps of 3 agents' states, a /tf holding their frames and, every 10th step, a text.
+  std::vector<Written> writeRun(BagWriter& bag, int steps) {
+    std::vector<Written> out;
+    for (int k = 0; k < steps; ++k) {
+      const ros::Time t = std::max(ros::Time(0.005 * k), ros::TIME_MIN);
+      tf2_msgs::TFMessage tf;
+      for (int i = 0; i < 3; ++i) {
+        AgentState s;
+        s.header.stamp = t;
+        s.header.frame_id = "agent_" + std::to_string(i);
+        s.id = static_cast<std::uint32_t>(i);
+        s.step = k;
+        s.position = {0.1 * k + i, -0.25 * i, 1e-17 * k};
+        const std::string topic = "/agent_" + std::to_string(i) + "/state";
+        bag.write(topic, t, s);
+        out.push_back(Written{topic, t, s, ""});
+        tf.transforms.emplace_back();
+        tf.transforms.back().child_frame_id = s.header.frame_id;
+      }
+      bag.write("/tf", t, tf);
+      out.push_back(Written{"/tf", t, {}, ""});
+      if (k % 10 == 0) {
+        std_msgs::String text;
+        text.data = std::string(static_cast<std::size_t>(k), 'x');
+        bag.write("/text", t, text);
+        out.push_back(Written{"/text", t, {}, text.data});
+      }
+    }
+    return out;
+  }
+
+  fs::path dir_;
+};
+
+TEST_P(BagWriterTest, RosbagReadsBackEveryMessageAsWritten) {
+  const auto [compression, chunkBytes] = GetParam();
+  BagWriter bag;
+  bag.open(path("run.bag"), compression, chunkBytes);
+  const std::vector<Written> written = writeRun(bag, 300);
+  bag.close();
+  EXPECT_EQ(bag.size(), fs::file_size(path("run.bag")));
+
+  rosbag::Bag in(path("run.bag"), rosbag::bagmode::Read);
+  rosbag::View all(in);
+  ASSERT_EQ(all.size(), written.size());
+  // rosbag's view orders by time (a step's messages share one): each topic in the order written.
+  std::map<std::string, std::vector<const Written*>> byTopic;
+  for (const Written& w : written) byTopic[w.topic].push_back(&w);
+  std::map<std::string, std::size_t> next;
+  ros::Time last;
+  std::size_t i = 0;
+  for (const rosbag::MessageInstance& m : all) {
+    ++i;
+    ASSERT_TRUE(byTopic.count(m.getTopic())) << m.getTopic();
+    ASSERT_LT(next[m.getTopic()], byTopic[m.getTopic()].size()) << m.getTopic();
+    const Written& w = *byTopic[m.getTopic()][next[m.getTopic()]++];
+    EXPECT_EQ(m.getTime(), w.time) << "message " << i;
+    EXPECT_GE(m.getTime(), last) << "message " << i;
+    last = m.getTime();
+    if (w.topic == "/tf") {
+      EXPECT_EQ(m.getDataType(), "tf2_msgs/TFMessage");
+      EXPECT_EQ(m.getMD5Sum(), ros::message_traits::md5sum<tf2_msgs::TFMessage>());
+      auto tf = m.instantiate<tf2_msgs::TFMessage>();
+      ASSERT_TRUE(tf);
+      EXPECT_EQ(tf->transforms.size(), 3u);
+    } else if (w.topic == "/text") {
+      auto text = m.instantiate<std_msgs::String>();
+      ASSERT_TRUE(text);
+      EXPECT_EQ(text->data, w.text);
+    } else {
+      EXPECT_EQ(m.getDataType(), "variational_formation_msgs/AgentState");
+      EXPECT_EQ(m.getMessageDefinition(), ros::message_traits::definition<AgentState>());
+      auto s = m.instantiate<AgentState>();
+      ASSERT_TRUE(s);
+      EXPECT_EQ(*s, w.state) << "message " << i;  // bit for bit: the doubles included
+    }
+  }
+  for (const auto& [topic, list] : byTopic) EXPECT_EQ(next[topic], list.size()) << topic;
+  // The index by topic and by time: one agent's states between two times.
+  rosbag::View some(in, rosbag::TopicQuery("/agent_1/state"), ros::Time(0.5), ros::Time(1.0));
+  std::vector<long> steps;
+  for (const rosbag::MessageInstance& m : some) steps.push_back(m.instantiate<AgentState>()->step);
+  ASSERT_EQ(steps.size(), 101u);  // t = 0.5 .. 1.0 s, both ends included
+  for (std::size_t j = 0; j < steps.size(); ++j) EXPECT_EQ(steps[j], 100 + static_cast<long>(j));
+  EXPECT_EQ(all.getBeginTime(), ros::TIME_MIN);
+  EXPECT_EQ(all.getEndTime(), ros::Time(0.005 * 299));
+  in.close();
+}
+
+// One chunk for the whole run, chunks of about 2 kB (a few steps each), a chunk per message.
+INSTANTIATE_TEST_SUITE_P(Chunks, BagWriterTest,
+                         ::testing::Combine(::testing::Values(BagWriter::Compression::None,
+                                                              BagWriter::Compression::Lz4),
+                                            ::testing::Values(768u * 1024u, 2000u, 1u)));
+
+class BagWriterUse : public BagWriterTest {};
+
+TEST_F(BagWriterUse, AnEmptyBagIsABagWithNoMessages) {
+  BagWriter bag;
+  bag.open(path("empty.bag"), BagWriter::Compression::Lz4, 1000);
+  bag.close();
+  rosbag::Bag in(path("empty.bag"), rosbag::bagmode::Read);
+  EXPECT_EQ(rosbag::View(in).size(), 0u);
+}
+
+TEST_F(BagWriterUse, Lz4ChunksAreSmallerThanPlainOnes) {
+  std::uintmax_t bytes[2] = {0, 0};
+  for (const auto compression : {BagWriter::Compression::None, BagWriter::Compression::Lz4}) {
+    const std::string file = path(compression == BagWriter::Compression::None ? "none.bag" : "lz4.bag");
+    BagWriter bag;
+    bag.open(file, compression, 768 * 1024);
+    writeRun(bag, 300);
+    bag.close();
+    bytes[compression == BagWriter::Compression::Lz4] = fs::file_size(file);
+  }
+  // The run's names and headers repeat from step to step; a plain chunk would be as large.
+  EXPECT_LT(static_cast<double>(bytes[1]), 0.6 * static_cast<double>(bytes[0])) << bytes[1] << " " << bytes[0];
+}
+
+TEST_F(BagWriterUse, ChunksOlderThanTheirAgeAreWrittenBeforeTheyFill) {
+  BagWriter bag;
+  bag.open(path("age.bag"), BagWriter::Compression::None, 1u << 30, 0.0);
+  std_msgs::String text;
+  text.data = "0123456789";
+  for (int k = 1; k <= 128; ++k) bag.write("/text", ros::Time(k), text);
+  // Written twice, at the 64th and 128th message: the file holds both chunks before the close.
+  EXPECT_EQ(fs::file_size(path("age.bag")), bag.size());
+  EXPECT_GT(bag.size(), 4096u + 128u * (10u + 4u + 4u + 38u));
+  bag.close();
+  rosbag::Bag in(path("age.bag"), rosbag::bagmode::Read);
+  EXPECT_EQ(rosbag::View(in).size(), 128u);
+}
+
+TEST_F(BagWriterUse, BadUsesAreOneLineNamingTheFile) {
+  const auto message = [](auto&& f) {
+    try {
+      f();
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  BagWriter bag;
+  EXPECT_EQ(message([&] { bag.open("/nonexistent/dir/x.bag", BagWriter::Compression::Lz4, 1000); }),
+            "/nonexistent/dir/x.bag: No such file or directory");
+  EXPECT_FALSE(bag.isOpen());
+  std_msgs::String text;
+  EXPECT_EQ(message([&] { bag.write("/text", ros::Time(1), text); }), "/nonexistent/dir/x.bag: not open");
+
+  bag.open(path("bad.bag"), BagWriter::Compression::Lz4, 1000);
+  EXPECT_EQ(message([&] { bag.write("/text", ros::Time(0), text); }),
+            path("bad.bag") + ": a message on /text at time 0 (a bag's times start at 1 ns)");
+  bag.write("/text", ros::Time(1), text);
+  AgentState s;
+  EXPECT_EQ(message([&] { bag.write("/text", ros::Time(2), s); }),
+            path("bad.bag") + ": topic /text was written as std_msgs/String, now as variational_formation_msgs/AgentState");
+  EXPECT_EQ(message([&] { bag.open(path("other.bag"), BagWriter::Compression::Lz4, 1000); }),
+            path("bad.bag") + ": already open (writing " + path("bad.bag") + ")");
+  bag.close();
+  // The bag holds what was written before the bad uses.
+  rosbag::Bag in(path("bad.bag"), rosbag::bagmode::Read);
+  EXPECT_EQ(rosbag::View(in).size(), 1u);
+}
+
+}  // namespace
+}  // namespace vf
