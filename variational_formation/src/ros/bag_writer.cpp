@@ -96,8 +96,15 @@ void BagWriter::open(const std::string& path, Compression compression, std::uint
   chunks_.clear();
   chunk_.clear();
   chunk_.reserve(chunkBytes_ + 64 * 1024);
-  put(kVersionLine, sizeof(kVersionLine) - 1);
-  writeFileHeader(0);  // rewritten at close with the index's position and the counts
+  try {
+    put(kVersionLine, sizeof(kVersionLine) - 1);
+    writeFileHeader(0);  // rewritten at close with the index's position and the counts
+    if (std::fflush(file_) != 0) failed(std::strerror(errno));
+  } catch (...) {
+    std::fclose(file_);
+    file_ = nullptr;
+    throw;
+  }
 }
 
 void BagWriter::writeFileHeader(std::uint64_t indexPosition) {

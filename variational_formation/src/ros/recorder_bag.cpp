@@ -94,7 +94,12 @@ void RecorderNode::writeListedCommands(std::size_t count, long step) {
 void RecorderNode::close(const std::string& how) {
   if (!open_) return;
   open_ = false;
-  bag_.close();
+  try {
+    bag_.close();
+  } catch (const std::exception& e) {
+    // A bag that failed to write fails again at its close: the run already failed, naming it.
+    ROS_ERROR("recorder: closing %s: %s", path_.c_str(), e.what());
+  }
   ROS_INFO("recorder: %s closed (%s): %ld messages, %ld repeated states not written again (%ld equal to the "
            "written copy bit for bit, %ld too old to compare), %ld dropped", path_.c_str(), how.c_str(), written_,
            protocol_->repeats(), protocol_->repeats() - protocol_->uncompared(), protocol_->uncompared(), dropped_);

@@ -394,6 +394,7 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
                  ("monitor", ["_trail_length:=1"], "~trail_length: must be >= 2"),
                  ("monitor", ["_window:=0"], "~window: must be >= 1"),
                  ("recorder", ["_bag:=/tmp/vf_probe.bag", "_max_size:=-1"], "~max_size: must be in [0, 1e9) MB"),
+                 ("recorder", ["_bag:=/tmp/vf_probe.bag", "_compression:=zip"], "~compression: must be lz4 or none, got 'zip'"),
                  ("agent", ["_id:=1", "_real_time_factor:=inf"], "~real_time_factor"),
                  ("agent", ["_id:=1", "_real_time_factor:=fast"], "~real_time_factor: expected a number"),
                  ("agent", ["_id:=99"], "id: must be an agent id 0..5, got 99"),

@@ -3,10 +3,13 @@
 // compressed or not, in one chunk or many; and a bad use is one line naming the file.
 #include <gtest/gtest.h>
 
+#include <csignal>
 #include <filesystem>
 #include <map>
 #include <string>
 #include <vector>
+
+#include <sys/resource.h>
 
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
@@ -197,9 +200,58 @@ TEST_F(BagWriterUse, BadUsesAreOneLineNamingTheFile) {
   EXPECT_EQ(message([&] { bag.open(path("other.bag"), BagWriter::Compression::Lz4, 1000); }),
             path("bad.bag") + ": already open (writing " + path("bad.bag") + ")");
   bag.close();
+  EXPECT_EQ(message([&] { bag.close(); }), "no error");  // a second close does nothing
   // The bag holds what was written before the bad uses.
   rosbag::Bag in(path("bad.bag"), rosbag::bagmode::Read);
   EXPECT_EQ(rosbag::View(in).size(), 1u);
+}
+
+TEST_F(BagWriterUse, AFullDiskIsOneLineAndLeavesNothingOpen) {
+  BagWriter bag;
+  try {
+    bag.open("/dev/full", BagWriter::Compression::None, 1);
+    FAIL() << "a full disk went unnoticed";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), "/dev/full: No space left on device");
+  }
+  EXPECT_FALSE(bag.isOpen());
+}
+
+TEST_F(BagWriterUse, AFileThatCannotGrowIsOneLineAndTheChunksBeforeItStayReadable) {
+  // A real limit on the file's size (RLIMIT_FSIZE, as `ulimit -f`): the write that crosses it
+  // fails with EFBIG (SIGXFSZ ignored), in the middle of the run.
+  std::signal(SIGXFSZ, SIG_IGN);
+  rlimit before{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &before), 0);
+  rlimit limit = before;
+  limit.rlim_cur = 64 * 1024;
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limit), 0);
+  BagWriter bag;
+  bag.open(path("limited.bag"), BagWriter::Compression::None, 4096);
+  std_msgs::String text;
+  text.data = std::string(1000, 'y');
+  std::string error;
+  int written = 0;
+  try {
+    for (int k = 1; k <= 1000; ++k, ++written) bag.write("/text", ros::Time(k), text);
+  } catch (const std::runtime_error& e) {
+    error = e.what();
+  }
+  EXPECT_THROW(bag.close(), std::runtime_error);  // its index cannot be written either
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &before), 0);
+  std::signal(SIGXFSZ, SIG_DFL);
+  EXPECT_EQ(error, path("limited.bag") + ": File too large");
+  EXPECT_GT(written, 40);
+  EXPECT_LT(written, 70);
+  EXPECT_FALSE(bag.isOpen());
+  // Without its index the file is what a killed recorder leaves: rosbag refuses it, and
+  // `rosbag reindex` recovers every whole chunk (4 messages each here) written before the failure.
+  EXPECT_THROW(rosbag::Bag(path("limited.bag"), rosbag::bagmode::Read), rosbag::BagException);
+  ASSERT_EQ(std::system(("rosbag reindex --quiet " + path("limited.bag") + " >/dev/null 2>&1").c_str()), 0);
+  rosbag::Bag in(path("limited.bag"), rosbag::bagmode::Read);
+  const auto recovered = static_cast<int>(rosbag::View(in).size());
+  EXPECT_LE(recovered, written);
+  EXPECT_GE(recovered, written - 8);
 }
 
 }  // namespace
