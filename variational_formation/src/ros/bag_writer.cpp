@@ -87,7 +87,6 @@ void BagWriter::open(const std::string& path, Compression compression, std::uint
   chunkBytes_ = std::max<std::uint32_t>(chunkBytes, 1);
   chunkAge_ = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
       std::chrono::duration<double>(std::max(chunkSeconds, 0.0)));
-  chunkMessages_ = 0;
   fileBytes_ = 0;
   connections_.clear();
   byTopic_.clear();
@@ -151,7 +150,6 @@ std::uint8_t* BagWriter::beginMessage(const std::string& topic, const char* type
     chunkStart_ = chunkEnd_ = time;
     chunkOpened_ = std::chrono::steady_clock::now();
   }
-  ++chunkMessages_;
   if (index_[conn].empty()) chunkConnections_.push_back(conn);
   index_[conn].push_back(IndexEntry{time, static_cast<std::uint32_t>(chunk_.size())});
   if (time < chunkStart_) chunkStart_ = time;
@@ -164,10 +162,7 @@ std::uint8_t* BagWriter::beginMessage(const std::string& topic, const char* type
 }
 
 void BagWriter::endMessage() {
-  if (chunk_.size() >= chunkBytes_ ||
-      (chunkMessages_ % 64 == 0 && std::chrono::steady_clock::now() - chunkOpened_ >= chunkAge_)) {
-    writeChunk();
-  }
+  if (chunk_.size() >= chunkBytes_ || std::chrono::steady_clock::now() - chunkOpened_ >= chunkAge_) writeChunk();
 }
 
 void BagWriter::writeChunk() {
@@ -216,7 +211,6 @@ void BagWriter::writeChunk() {
   chunks_.push_back(std::move(info));
   chunkConnections_.clear();
   chunk_.clear();
-  chunkMessages_ = 0;
 }
 
 void BagWriter::close() {
