@@ -149,6 +149,7 @@ std::uint8_t* BagWriter::beginMessage(const std::string& topic, const char* type
   if (chunkConnections_.empty()) {
     chunkStart_ = chunkEnd_ = time;
     chunkOpened_ = std::chrono::steady_clock::now();
+    chunkMessages_ = 0;
   }
   if (index_[conn].empty()) chunkConnections_.push_back(conn);
   index_[conn].push_back(IndexEntry{time, static_cast<std::uint32_t>(chunk_.size())});
@@ -162,7 +163,11 @@ std::uint8_t* BagWriter::beginMessage(const std::string& topic, const char* type
 }
 
 void BagWriter::endMessage() {
-  if (chunk_.size() >= chunkBytes_ || std::chrono::steady_clock::now() - chunkOpened_ >= chunkAge_) writeChunk();
+  // The clock is read at every 16th message of a chunk: a step of the recorder writes 9 or more.
+  if (chunk_.size() >= chunkBytes_ ||
+      (++chunkMessages_ % 16 == 0 && std::chrono::steady_clock::now() - chunkOpened_ >= chunkAge_)) {
+    writeChunk();
+  }
 }
 
 void BagWriter::writeChunk() {

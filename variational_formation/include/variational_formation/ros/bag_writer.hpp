@@ -40,8 +40,8 @@ class BagWriter {
   ~BagWriter();
 
   /// Creates (or truncates) `path`. A chunk is written once it holds `chunkBytes` bytes or more
-  /// (uncompressed; at least 1), or at the first message once it has been open `chunkSeconds`
-  /// of wall time: a killed writer loses at most the messages of its last chunkSeconds.
+  /// (uncompressed; at least 1), or once it has been open `chunkSeconds` of wall time (the age
+  /// is looked at every 16th message): a killed writer loses about its last chunkSeconds.
   void open(const std::string& path, Compression compression, std::uint32_t chunkBytes, double chunkSeconds = 1.0);
   bool isOpen() const { return file_ != nullptr; }
   const std::string& path() const { return path_; }
@@ -95,6 +95,7 @@ class BagWriter {
   std::uint32_t chunkBytes_ = 768 * 1024;
   std::chrono::steady_clock::duration chunkAge_{};
   std::chrono::steady_clock::time_point chunkOpened_;
+  std::uint32_t chunkMessages_ = 0;
   std::uint64_t fileBytes_ = 0;
   std::vector<Connection> connections_;
   std::unordered_map<std::string, std::uint32_t> byTopic_;
