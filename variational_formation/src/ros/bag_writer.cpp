@@ -94,7 +94,7 @@ void BagWriter::open(const std::string& path, Compression compression, std::uint
   chunkConnections_.clear();
   chunks_.clear();
   chunk_.clear();
-  chunk_.reserve(chunkBytes_ + 64 * 1024);
+  chunk_.reserve(std::min<std::uint32_t>(chunkBytes_, 1024 * 1024) + 64 * 1024);  // a big limit grows as needed
   try {
     put(kVersionLine, sizeof(kVersionLine) - 1);
     writeFileHeader(0);  // rewritten at close with the index's position and the counts
@@ -134,11 +134,16 @@ std::uint32_t BagWriter::connection(const std::string& topic, const char* type, 
   index_.emplace_back();
   // Its connection record goes into the chunk that holds its first message, as rosbag does (so
   // `rosbag reindex` finds it), and again with the index at the end.
-  const Connection& c = connections_.back();
-  Fields(chunk_).op(kOpConnection).u32("conn", id).text("topic", c.topic).done();
-  Fields(chunk_).text("topic", c.topic).text("type", c.type).text("md5sum", c.md5sum)
-      .text("message_definition", c.definition).done();
+  appendConnectionRecord(chunk_, id);
   return id;
+}
+
+void BagWriter::appendConnectionRecord(std::vector<std::uint8_t>& out, std::uint32_t id) const {
+  const Connection& c = connections_[id];
+  Fields(out).op(kOpConnection).u32("conn", id).text("topic", c.topic).done();
+  // Its data is the connection header, as rosbag writes it for a message written without one.
+  Fields(out).text("topic", c.topic).text("type", c.type).text("md5sum", c.md5sum)
+      .text("message_definition", c.definition).done();
 }
 
 std::uint8_t* BagWriter::beginMessage(const std::string& topic, const char* type, const char* md5sum,
@@ -224,12 +229,7 @@ void BagWriter::close() {
     writeChunk();
     const std::uint64_t indexPosition = fileBytes_;
     record_.clear();
-    for (std::uint32_t id = 0; id < connections_.size(); ++id) {
-      const Connection& c = connections_[id];
-      Fields(record_).op(kOpConnection).u32("conn", id).text("topic", c.topic).done();
-      Fields(record_).text("topic", c.topic).text("type", c.type).text("md5sum", c.md5sum)
-          .text("message_definition", c.definition).done();
-    }
+    for (std::uint32_t id = 0; id < connections_.size(); ++id) appendConnectionRecord(record_, id);
     for (const ChunkInfo& info : chunks_) {
       const auto count = static_cast<std::uint32_t>(info.counts.size());
       Fields(record_).op(kOpChunkInfo).u32("ver", kChunkInfoVersion).u64("chunk_pos", info.position)

@@ -44,7 +44,6 @@ class BagWriter {
   /// is looked at every 16th message): a killed writer loses about its last chunkSeconds.
   void open(const std::string& path, Compression compression, std::uint32_t chunkBytes, double chunkSeconds = 1.0);
   bool isOpen() const { return file_ != nullptr; }
-  const std::string& path() const { return path_; }
 
   /// Appends `msg` on `topic` at bag time `time` (> 0). A topic keeps the type it was first
   /// written with.
@@ -79,6 +78,8 @@ class BagWriter {
   };
 
   std::uint32_t connection(const std::string& topic, const char* type, const char* md5sum, const char* definition);
+  /// Appends connection `id`'s record (in its first chunk, and again in the index at the end).
+  void appendConnectionRecord(std::vector<std::uint8_t>& out, std::uint32_t id) const;
   /// Starts a message data record in the chunk, and returns where its `length` bytes go.
   std::uint8_t* beginMessage(const std::string& topic, const char* type, const char* md5sum, const char* definition,
                              const ros::Time& time, std::uint32_t length);
