@@ -251,7 +251,12 @@ class RenderTest(RecordedHexagon):
         end = time.time() + 120
         while not watched.running("x11grab") and time.time() < end and watched.proc.poll() is None:
             time.sleep(0.1)
-        self.assertTrue(watched.running("x11grab"), "the capture never started")
+        if not watched.running("x11grab"):
+            status = watched.proc.poll()
+            if status is None:
+                watched.proc.kill()
+            _, out, err = watched.finish()
+            self.fail(f"the capture never started (render exit status {status}): {(out + err)[-1500:]}")
         time.sleep(3.0)  # into the replay, which lasts 4.2 s / 0.25 = 17 s
         watched.proc.send_signal(signal.SIGINT)
         self.assert_one_line_error(watched.finish(), 130, ["interrupted"])
