@@ -30,7 +30,7 @@ LockstepMonitor::LockstepMonitor(ros::NodeHandle& nh, ros::NodeHandle& pnh) : Mo
   announce(recorder_.node);
 }
 
-bool LockstepMonitor::offer(int agent, const AgentState& msg, const std::string& publisher) {
+bool LockstepMonitor::offer(int agent, const AgentState::ConstPtr& msg, const std::string& publisher) {
   std::string why;
   try {
     const auto receipt = referee_->offerState(agent, msg);
@@ -38,7 +38,7 @@ bool LockstepMonitor::offer(int agent, const AgentState& msg, const std::string&
       heard(agent, publisher);
       return receipt == FormationMonitor::Receipt::Accepted;
     }
-    why = "(step " + std::to_string(msg.step) + "): " + FormationMonitor::describe(receipt);
+    why = "(step " + std::to_string(msg->step) + "): " + FormationMonitor::describe(receipt);
   } catch (const std::exception& e) {
     why = e.what();
   }
@@ -91,7 +91,7 @@ void LockstepMonitor::watch() {
     // agent still holds it: catch up from the histories of the agents that are missing.
     if (progress_.state != RunProgress::WAITING && !missing.empty()) {
       const auto held = fetchHistories(missing);
-      for (std::size_t k = 0; k < missing.size(); ++k) referee_->offerHistory(missing[k], held[k].states);
+      for (std::size_t k = 0; k < missing.size(); ++k) referee_->offerHistory(missing[k], heldStates(held[k].states));
       catchUpFromNeighbours(referee_->missing());
       updateProgress();
     }
@@ -117,13 +117,13 @@ void LockstepMonitor::watch() {
 }
 
 bool LockstepMonitor::onRecall(RecallState::Request& request, RecallState::Response& response) {
-  const AgentState* newest =
+  const AgentState::ConstPtr* newest =
       request.id < static_cast<std::size_t>(agents_.size()) ? referee_->newest(static_cast<int>(request.id)) : nullptr;
   response.held = newest != nullptr;
   if (response.held) {
-    response.step = newest->step;
-    response.position = newest->position;
-    response.previous_position = newest->previous_position;
+    response.step = (*newest)->step;
+    response.position = (*newest)->position;
+    response.previous_position = (*newest)->previous_position;
   }
   return true;
 }
@@ -131,11 +131,19 @@ bool LockstepMonitor::onRecall(RecallState::Request& request, RecallState::Respo
 bool LockstepMonitor::onHistory(RecallHistory::Request& request, RecallHistory::Response& response) {
   if (request.id >= 0 && request.id < static_cast<int>(agents_.size())) {
     const auto& states = referee_->unrecordedStates(request.id);
-    response.states.assign(states.begin(), states.end());
+    response.states.reserve(states.size());
+    for (const AgentState::ConstPtr& s : states) response.states.push_back(*s);
   }
   response.progress = progress_;
   response.has_progress = true;
   return true;
+}
+
+std::vector<AgentState::ConstPtr> LockstepMonitor::heldStates(const std::vector<AgentState>& states) {
+  std::vector<AgentState::ConstPtr> held;
+  held.reserve(states.size());
+  for (const AgentState& s : states) held.push_back(boost::make_shared<AgentState>(s));
+  return held;
 }
 
 std::vector<RecallHistory::Response> LockstepMonitor::fetchHistories(const std::vector<int>& ids) {
@@ -170,7 +178,7 @@ void LockstepMonitor::catchUpFromNeighbours(const std::vector<int>& ids) {
   const std::vector<bool> answered = callAllWithTimeout(services, calls, 2.0);
   const long next = completedStep() + 1;
   for (std::size_t c = 0; c < calls.size(); ++c) {
-    if (answered[c]) referee_->offerHistory(whose[c], calls[c].response.states);
+    if (answered[c]) referee_->offerHistory(whose[c], heldStates(calls[c].response.states));
   }
   const std::vector<int> still = measure().missingAt(next);
   for (int i : ids) {
@@ -187,12 +195,12 @@ void LockstepMonitor::begin() {
   for (std::size_t i = 0; i < agents_.size(); ++i) all.push_back(static_cast<int>(i));
   const std::vector<RecallHistory::Response> held = fetchHistories(all);
   std::vector<protocol::ProgressAnswer> answers;
-  std::vector<std::vector<AgentState>> histories;
+  std::vector<std::vector<AgentState::ConstPtr>> histories;
   for (const auto& h : held) {
     const bool over = h.progress.state == RunProgress::FINISHED || h.progress.state == RunProgress::FAILED;
     answers.push_back({true, static_cast<bool>(h.has_progress), h.progress.completed_step, h.progress.converged_step,
                        over, h.progress.state == RunProgress::FINISHED});
-    histories.push_back(h.states);
+    histories.push_back(heldStates(h.states));
   }
   const Referee::Ready resumed = referee_->step(Referee::Resume{answers, histories});
   // It did not witness a run that is over: neither its outcome nor a new run is its to report.

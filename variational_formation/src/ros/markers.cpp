@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include "variational_formation_core/model/spatial_grid.hpp"
 
@@ -27,10 +28,10 @@ geometry_msgs::Point point(const Eigen::Vector3d& p) {
   return q;
 }
 
+/// q_i in 3D (z = 0 in 2D), element by element: a dynamic-size head copy cost more than the
+/// rest of a step's markers.
 Eigen::Vector3d column3(const Positions& q, int i) {
-  Eigen::Vector3d p = Eigen::Vector3d::Zero();
-  p.head(q.rows()) = q.col(i);
-  return p;
+  return {q(0, i), q.rows() > 1 ? q(1, i) : 0.0, q.rows() > 2 ? q(2, i) : 0.0};
 }
 
 visualization_msgs::Marker base(const std::string& ns, int id, int type, const ros::Time& stamp) {
@@ -153,6 +154,10 @@ Marker trailLines(const FormationSnapshot& s, const Trails& trails, double radiu
   const int n = trails.agents();
   Marker lines = base("trails", 0, Marker::LINE_LIST, stamp);
   lines.scale.x = 0.25 * radius;
+  std::size_t segments = 0;
+  for (int i = 0; i < n; ++i) segments += trails.of(i).size() + 1;  // at most
+  lines.points.reserve(2 * segments);
+  lines.colors.reserve(2 * segments);
   lines.color = rgba(1.0, 1.0, 1.0, 0.6);
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d q = column3(s.positions, i);
@@ -187,6 +192,9 @@ void addEdgesAndGhostEdges(const FormationSnapshot& s, const Formation& formatio
   Marker ghost = base("desired_shape", 0, Marker::LINE_LIST, stamp);
   ghost.scale.x = 0.2 * radius;
   ghost.color = rgba(0.7, 0.7, 0.7, 0.35);
+  edges.points.reserve(2 * formation.edges().size());
+  edges.colors.reserve(2 * formation.edges().size());
+  if (ghostToo) ghost.points.reserve(2 * formation.edges().size());
   for (std::size_t e = 0; e < formation.edges().size(); ++e) {
     const Edge& edge = formation.edges()[e];
     // The status's error, against s d_ij under a commanded scale s.
@@ -201,8 +209,8 @@ void addEdgesAndGhostEdges(const FormationSnapshot& s, const Formation& formatio
     }
   }
   if (!edges.points.empty()) {
-    out.markers.push_back(edges);
-    if (ghostToo) out.markers.push_back(ghost);
+    out.markers.push_back(std::move(edges));
+    if (ghostToo) out.markers.push_back(std::move(ghost));
   }
 }
 
@@ -211,6 +219,7 @@ Marker ghostAgents(const Formation& formation, const Ghost& ghostAt, double radi
   Marker m = base("desired_shape", 1, Marker::SPHERE_LIST, stamp);
   m.scale.x = m.scale.y = m.scale.z = 1.2 * radius;
   m.color = rgba(0.7, 0.7, 0.7, 0.25);
+  m.points.reserve(static_cast<std::size_t>(formation.agentCount()));
   for (int i = 0; i < formation.agentCount(); ++i) m.points.push_back(ghostAt.agent(formation, i));
   return m;
 }
@@ -245,6 +254,7 @@ visualization_msgs::MarkerArray makeMarkers(const FormationSnapshot& s, const Fo
                                             const Trails& trails, const CommandSchedule* schedule,
                                             double timeStep, MarkerParts parts) {
   visualization_msgs::MarkerArray out;
+  out.markers.reserve(6);
   const ros::Time stamp = ros::Time::now();
   const int n = formation.agentCount();
   const double radius = markerRadius(formation);

@@ -102,12 +102,13 @@ void MonitorNode::announce(const std::string& recorder) const {
 }
 
 void MonitorNode::onAgentTopic(int agent, const ros::MessageEvent<AgentState const>& event) {
-  const AgentState& msg = *event.getConstMessage();
+  const AgentState::ConstPtr& held = event.getConstMessage();
+  const AgentState& msg = *held;
   if (!fromAgent(event, agents_[static_cast<std::size_t>(agent)].node, managers_)) {
     drop(agent, "from " + event.getPublisherName() + ", which does not own it");
   } else if (static_cast<int>(msg.id) != agent) {
     drop(agent, "with id " + std::to_string(msg.id));
-  } else if (admit(agent, msg, event.getPublisherName())) {
+  } else if (admit(agent, held, event.getPublisherName())) {
     afterAccepted();
   }
 }
@@ -128,19 +129,21 @@ void MonitorNode::onBatch(std::size_t source, const ros::MessageEvent<variationa
                         msg.id, from.manager.c_str());
       continue;
     }
-    accepted = admit(static_cast<int>(msg.id), msg, event.getPublisherName()) || accepted;
+    // Held by pointer into the batch (which it keeps alive), not copied.
+    accepted = admit(static_cast<int>(msg.id), AgentState::ConstPtr(event.getConstMessage(), &msg),
+                     event.getPublisherName()) || accepted;
     if (ended()) return;
   }
   if (accepted) afterAccepted();
 }
 
-bool MonitorNode::admit(int agent, const AgentState& msg, const std::string& publisher) {
-  if (!msg.failure.empty()) {
-    report(protocol::Failure{agents_[static_cast<std::size_t>(agent)].node + ": " + msg.failure});
+bool MonitorNode::admit(int agent, const AgentState::ConstPtr& msg, const std::string& publisher) {
+  if (!msg->failure.empty()) {
+    report(protocol::Failure{agents_[static_cast<std::size_t>(agent)].node + ": " + msg->failure});
     return false;
   }
   if (!offer(agent, msg, publisher)) return false;
-  noteSafety(agent, msg);
+  noteSafety(agent, *msg);
   return true;
 }
 

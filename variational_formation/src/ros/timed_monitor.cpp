@@ -18,9 +18,9 @@ TimedMonitor::TimedMonitor(ros::NodeHandle& nh, ros::NodeHandle& pnh) : MonitorN
   announce("");
 }
 
-bool TimedMonitor::offer(int agent, const AgentState& msg, const std::string& publisher) {
+bool TimedMonitor::offer(int agent, const AgentState::ConstPtr& msg, const std::string& publisher) {
   std::string why;
-  if (!referee_->offerState(agent, msg, ros::WallTime::now().toSec(), why)) {
+  if (!referee_->offerState(agent, *msg, ros::WallTime::now().toSec(), why)) {
     drop(agent, why);
     return false;
   }

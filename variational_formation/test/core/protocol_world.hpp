@@ -190,6 +190,8 @@ class World {
   long writtenThrough() const { return recorder_.steps().handedOutThrough(); }
   long delivered() const { return delivered_; }
   long maxPendingSteps() const { return maxPending_; }
+  /// How many progress reports the recorder sent.
+  long recorderReports() const { return recorderReports_; }
   /// How often a restarted agent asked its holders again (Ready::recallAgain).
   long recalledAgain() const { return recalledAgain_; }
   /// The newest step any live agent computed.
@@ -431,6 +433,7 @@ class World {
     }
     if (r.report) {
       recorderReported_ = r.report->completedStep;
+      ++recorderReports_;
       recorderFinished_ = r.report->state == Progress::State::Finished;
       send({Message::Kind::RecorderProgress, Message::Monitor, {}, {}, recorderReported_, recorderFinished_, -1});
     }
@@ -472,6 +475,7 @@ class World {
   Recorder recorder_;
   double recorderClock_ = 0.0;
   long latchedStatus_ = -1, written_ = -1, recorderReported_ = -1, maxPending_ = 0, delivered_ = 0;
+  long recorderReports_ = 0;
   bool recorderFinished_ = false, finished_ = false;
   std::string failure_;
   std::vector<Message> inFlight_;

@@ -477,6 +477,30 @@ TEST(ProtocolRun, RecorderThatFallsBehindHoldsTheAgentsWithinTheWindow) {
   EXPECT_LE(w.maxPendingSteps(), protocol::recorderLead(window));
 }
 
+/// Delivers every message in order, and never runs a timer. @return false if it stopped short.
+bool runWithoutTimers(World& w) {
+  while (!w.finished() && !w.failed() && !w.inFlight().empty()) w.deliver(0);
+  return w.finished();
+}
+
+TEST(ProtocolRun, RecorderReportsEveryFewStepsWithoutEverHoldingTheAgentsBack) {
+  // One report per step woke the monitor at every step. Now the recorder reports every
+  // kReportEvery whole steps, and at once when the agents may wait for it. With no timer at all
+  // (a timer would hide a stall as a half-second pause) both runs must still end.
+  const long steps = 200;
+  World wide(shortScenario("square", steps), 40, 1);
+  ASSERT_TRUE(runWithoutTimers(wide)) << wide.waitingFor();
+  expectComplete(wide, steps);
+  // Step 0, then every 16th step, then the last: 14 reports, against 201 before.
+  EXPECT_LE(wide.recorderReports(), steps / test::Recorder::kReportEvery + 2);
+  EXPECT_GE(wide.recorderReports(), steps / test::Recorder::kReportEvery);
+  // A window of one step: the agents wait for the recorder at every step, so it reports each.
+  World narrow(shortScenario("square", 30), 1, 1);
+  ASSERT_TRUE(runWithoutTimers(narrow)) << narrow.waitingFor();
+  expectComplete(narrow, 30);
+  EXPECT_GE(narrow.recorderReports(), 30);
+}
+
 // ---- seeded random interleavings ----
 
 struct Chances {

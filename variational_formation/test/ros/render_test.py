@@ -110,13 +110,16 @@ class Watched:
                         family.add(pid)
                         grew = True
             for pid in family - {self.proc.pid}:
-                if pid not in self.seen:
-                    try:
-                        with open(f"/proc/{pid}/cmdline") as f:
-                            cmdline = f.read().replace("\0", " ").strip()
-                    except OSError:
-                        cmdline = "?"
-                    self.seen[pid] = (stats[pid][1], stats[pid][2], cmdline)
+                # Read again at every poll: a child seen between its fork and its exec still
+                # shows the render's own command line (a CI run once missed ffmpeg that way).
+                try:
+                    with open(f"/proc/{pid}/cmdline") as f:
+                        cmdline = f.read().replace("\0", " ").strip()
+                except OSError:
+                    cmdline = ""
+                known = self.seen.get(pid)
+                if known is None or (known[1] == stats[pid][2] and cmdline):
+                    self.seen[pid] = (stats[pid][1], stats[pid][2], cmdline or "?")
             time.sleep(0.1)
 
     def running(self, word):

@@ -73,7 +73,8 @@ class MonitorNode {
 
   // What the mode decides.
   /// A state of `agent` that passed the identity checks, from `publisher`. @return accepted.
-  virtual bool offer(int agent, const AgentState& msg, const std::string& publisher) = 0;
+  /// @param msg held by pointer (into the batch it came in, which it keeps alive), not copied.
+  virtual bool offer(int agent, const AgentState::ConstPtr& msg, const std::string& publisher) = 0;
   /// After one or more accepted states (a state, or a manager's batch).
   virtual void afterAccepted() {}
   virtual void begin() = 0;  ///< before spinning (a restarted lockstep monitor recovers here)
@@ -163,7 +164,7 @@ class MonitorNode {
   void finish(const protocol::Progress& end);
   bool ended() const { return exitStatus_ >= 0; }
   static std::string agentList(const std::vector<int>& ids) {
-    return protocol::LockstepReferee<AgentState, Published>::agentList(ids);
+    return protocol::LockstepReferee<AgentState::ConstPtr, Published>::agentList(ids);
   }
 
   ros::NodeHandle nh_;
@@ -221,7 +222,7 @@ class MonitorNode {
   void onAgentTopic(int agent, const ros::MessageEvent<AgentState const>& event);
   void onBatch(std::size_t source, const ros::MessageEvent<variational_formation_msgs::AgentStates const>& event);
   /// A state from a sender allowed to speak for `agent`: ends the run on its failure, else offers it.
-  bool admit(int agent, const AgentState& msg, const std::string& publisher);
+  bool admit(int agent, const AgentState::ConstPtr& msg, const std::string& publisher);
 
   std::vector<ros::Subscriber> subs_;
   std::vector<BatchSource> batches_;  // managers whose agents come batched (doc/distributed.md, "Batches")
@@ -266,8 +267,8 @@ class LockstepMonitor : public MonitorNode {
   LockstepMonitor(ros::NodeHandle& nh, ros::NodeHandle& pnh);
 
  private:
-  using Referee = protocol::LockstepReferee<AgentState, Published>;
-  bool offer(int agent, const AgentState& msg, const std::string& publisher) override;
+  using Referee = protocol::LockstepReferee<AgentState::ConstPtr, Published>;
+  bool offer(int agent, const AgentState::ConstPtr& msg, const std::string& publisher) override;
   void afterAccepted() override { updateProgress(); }
   void begin() override;
   void watch() override;
@@ -288,6 +289,8 @@ class LockstepMonitor : public MonitorNode {
   void carryOut(const Referee::Ready& r);
   /// The states agents `ids` hold of themselves (`~history`), in order of `ids`.
   std::vector<RecallHistory::Response> fetchHistories(const std::vector<int>& ids);
+  /// A history's states (a service answer), held as the referee holds them.
+  static std::vector<AgentState::ConstPtr> heldStates(const std::vector<AgentState>& states);
   void catchUpFromNeighbours(const std::vector<int>& ids);
 
   std::unique_ptr<Referee> referee_;
@@ -308,7 +311,7 @@ class TimedMonitor : public MonitorNode {
   TimedMonitor(ros::NodeHandle& nh, ros::NodeHandle& pnh);
 
  private:
-  bool offer(int agent, const AgentState& msg, const std::string& publisher) override;
+  bool offer(int agent, const AgentState::ConstPtr& msg, const std::string& publisher) override;
   void begin() override;
   void watch() override;
   std::string waitingFor() const override;

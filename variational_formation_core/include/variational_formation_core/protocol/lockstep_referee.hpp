@@ -16,6 +16,18 @@
 
 namespace vf::protocol {
 
+namespace detail {
+/// The message a held state is: the state itself, or what a pointer to it points to.
+template <class S>
+auto heldMessage(const S& s, int) -> decltype(*s) {
+  return *s;
+}
+template <class S>
+const S& heldMessage(const S& s, long) {
+  return s;
+}
+}  // namespace detail
+
 /**
  * The referee of a lockstep run without a transport (doc/distributed.md): the monitor's side of
  * the protocol. It takes events (a state from an agent or from a history, the recorder's
@@ -35,8 +47,9 @@ namespace vf::protocol {
  * - Failures: every end of the run is its decision (step(Failure), step(Blocked), the recorder's
  *   failure, the last step); the node finishes only when a Ready says so.
  *
- * State is the caller's message type with fields step, position and previous_position; Published
- * is what it publishes per completed step (kept for the recorder).
+ * State is the caller's message type with fields step, position and previous_position, or a
+ * shared pointer to one (the monitor holds its states by pointer into the batches they came in,
+ * not as copies); Published is what it publishes per completed step (kept for the recorder).
  */
 template <class State, class Published>
 class LockstepReferee {
@@ -55,11 +68,12 @@ class LockstepReferee {
 
   /// A state of `agent` (from its topic, or `fromHistory`). Validated by FormationMonitor::add.
   FormationMonitor::Receipt offerState(int agent, const State& s, bool fromHistory = false) {
-    const auto receipt = monitor_->add(agent, s.step, s.position, s.previous_position, acceptUpTo_);
+    const auto& m = message(s);
+    const auto receipt = monitor_->add(agent, m.step, m.position, m.previous_position, acceptUpTo_);
     const bool accepted = receipt == FormationMonitor::Receipt::Accepted;
     if (accepted || (!fromHistory && receipt == FormationMonitor::Receipt::Duplicate)) {
       const std::size_t i = static_cast<std::size_t>(agent);
-      if (!held_[i] || s.step > newest_[i].step) {
+      if (!held_[i] || m.step > message(newest_[i]).step) {
         newest_[i] = s;
         held_[i] = true;
       }
@@ -75,7 +89,7 @@ class LockstepReferee {
     recordedStep_ = std::max(recordedStep_, completedStep);
     while (!unrecorded_.empty() && unrecorded_.front().first <= recordedStep_) unrecorded_.pop_front();
     for (auto& states : unrecordedStates_) {
-      while (!states.empty() && states.front().step <= recordedStep_) states.pop_front();
+      while (!states.empty() && message(states.front()).step <= recordedStep_) states.pop_front();
     }
     recorderDone_ = finished;
   }
@@ -220,6 +234,8 @@ class LockstepReferee {
   bool recorderLags() const { return recording_ && recordedStep_ < completedStep(); }
   /// Agent i's accepted states the recorder has not confirmed (its `~history` answer).
   const std::deque<State>& unrecordedStates(int agent) const { return unrecordedStates_[static_cast<std::size_t>(agent)]; }
+  /// The message a held state is (State itself, or what it points to).
+  static decltype(auto) message(const State& s) { return detail::heldMessage(s, 0); }
   /// Agent i's newest state, for its `~recall`; nullptr if none.
   const State* newest(int agent) const {
     return held_[static_cast<std::size_t>(agent)] ? &newest_[static_cast<std::size_t>(agent)] : nullptr;

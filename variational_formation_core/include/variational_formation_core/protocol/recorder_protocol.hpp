@@ -25,8 +25,11 @@ namespace vf::protocol {
  *   one that differs fails the recording.
  * - Steps are handed out whole and in order (StepAssembler), and a step only once the recorder
  *   holds every command its status counts; each step says which listed commands to write before it.
- * - Its progress (what it holds whole) is reported on every new whole step; the last step
- *   finishes the recording.
+ * - Its progress (what it holds whole) is reported every kReportEvery whole steps, and at once
+ *   when the agents may be waiting for it (it holds every step the monitor's newest progress it
+ *   heard allows) or at its first and last step; a tick reports what is still unreported. Each
+ *   report wakes the monitor's threads (doc/benchmarks.md, "Recording at 100 agents, third
+ *   round"). The last step finishes the recording.
  * - Catch-up: once its completed step has not moved for a second (caller's clock), it asks for
  *   the histories of the agents whose part of the next step it lacks.
  *
@@ -42,6 +45,8 @@ class RecorderProtocol {
   using CommandsCounted = std::function<long(const Status&)>;
   /// The time [s] after which a recorder whose completed step does not move catches up.
   static constexpr double kCatchUpAfter = 1.0;
+  /// Whole steps between two reports, at most, unless the agents may be waiting for one.
+  static constexpr long kReportEvery = 16;
 
   /// A whole step to write.
   struct Write {
@@ -132,6 +137,8 @@ class RecorderProtocol {
   }
   Ready step(const MonitorProgress& e) {
     Ready r;
+    monitorAllows_ = std::max(monitorAllows_, e.progress.allowedStep);
+    report(r);  // the agents may wait at that step already
     if (over(e.progress)) {
       r.close = e.progress.state == Progress::State::Finished ? "finished" : "the run failed";
       r.exit = 0;
@@ -143,6 +150,7 @@ class RecorderProtocol {
     // are lost to this subscriber, but their agent (or the monitor) still holds them.
     Ready r;
     if (over(progress_)) return r;
+    report(r, true);
     if (progress_.completedStep != lastCatchUpStep_) {
       lastCatchUpStep_ = progress_.completedStep;
       stalledSince_ = e.now;
@@ -225,10 +233,15 @@ class RecorderProtocol {
     report(r);
   }
   /// Complete up to k: every agent's state, the status and the markers of steps 0..k are out.
-  void report(Ready& r) {
+  /// Reported at once if `now`, if the agents may wait for it, at the first and last step, and
+  /// every kReportEvery steps; otherwise held back.
+  void report(Ready& r, bool now = false) {
     if (over(progress_)) return;
     const long complete = steps_.handedOutThrough();
     if (complete <= progress_.completedStep) return;
+    const bool first = progress_.state == Progress::State::Waiting;
+    const bool last = lastStep_ > 0 && complete >= lastStep_;
+    if (!(now || first || last || complete >= monitorAllows_ || complete >= progress_.completedStep + kReportEvery)) return;
     progress_.completedStep = complete;
     progress_.state = Progress::State::Running;
     if (lastStep_ > 0 && complete >= lastStep_) {
@@ -256,6 +269,7 @@ class RecorderProtocol {
   std::size_t commandsInBag_ = 0;
   long repeats_ = 0, uncompared_ = 0, refused_ = 0;
   long lastCatchUpStep_ = -2;
+  long monitorAllows_ = 0;  // the newest allowed step heard from the monitor (it only grows)
   double stalledSince_ = 0.0;
 };
 
