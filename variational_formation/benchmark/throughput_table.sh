@@ -28,10 +28,16 @@
 # gave 2357 to 4149 steps/s at 100 agents in five runs, the ceiling 2484 to 3814 at 200.)
 # Targets: agent-steps/s at 200 >= 0.8 x at 100 and at 1000 >= 0.7 x at 100 ("flat per-agent
 # cost"); lockstep >= 0.7 x ceiling at 100 and at 200 ("near the ceiling"). A target whose counts
-# were not run is not printed. Exit status 0 whether or not targets pass (the table is the output).
+# were not run is not printed. Then issue 34's other targets, each from its own script run once
+# after the table (VF_TABLE_ALL=0 skips them): recording (recorded / unrecorded >= 0.5 at those of
+# 100 and 1000 that were listed) and pacing (a paced run keeps real time, >= 0.98, at 100 and 500
+# agents) from benchmark/recording_pacing.sh, whose tables are printed too; simulate's per-agent
+# cost within 1.3x from 100 to 10,000 agents, from benchmark/simulate_scaling.py.
+# Exit status 0 whether or not targets pass (the table is the output).
 # usage: benchmark/throughput_table.sh [agent counts (default 100 200)]
 # environment: VF_BENCH_PORT_BASE (default 11500; the masters use 100 ports from there), VF_TABLE_ROUNDS
-#   (default 3: runs of each count, the median given).
+#   (default 3: runs of each count, the median given), VF_TABLE_ALL (default 1: also the recording,
+#   pacing and simulate targets).
 source "$(dirname "${BASH_SOURCE[0]}")/../scripts/common.sh"
 vf_install_dependencies
 vf_build
@@ -112,4 +118,34 @@ if has 100; then
     has "$n" && echo "ceiling's own flatness, agent-steps/s at $n / at 100: $(ratio $(( ${ceiling[$n]:-0} * n )) $(( ${ceiling[100]:-0} * 100 )))"
   done
 fi
+[ "${VF_TABLE_ALL:-1}" = 1 ] || exit 0
+
+# Recording and pacing: recording_pacing.sh's own tables, then a target line per row.
+record=()
+for n in 100 1000; do has "$n" && record+=("$n"); done
+echo
+rp=$(VF_RP_RECORD="${record[*]:- }" VF_RP_PACE="100 500" VF_BENCH_PORT_BASE="$port_base" \
+     "$REPO/benchmark/recording_pacing.sh" 2>/dev/null || true)
+echo "$rp" | grep '^|' || echo "recording_pacing.sh printed no table"
+echo
+# Rows of its two tables: | agents | unrecorded | recorded | ratio | exact | and
+# | agents | h | unpaced | unpaced rtf | paced | simulated s | wall s | sim / wall |.
+echo "$rp" | awk -F'|' '
+  NF == 7 && $2 + 0 > 0 {
+    r = $5; gsub(/ /, "", r); exact = $6; gsub(/ /, "", exact)
+    ok = (r != "n/a" && r + 0 >= 0.5 && exact == "yes")
+    printf "recording, recorded / unrecorded at %d agents: %s, exact: %s (target >= 0.5, exact): %s\n", $2, r, exact, ok ? "pass" : "FAIL" }
+  NF == 10 && $2 + 0 > 0 {
+    keep = $9; gsub(/ /, "", keep); rtf = $5; gsub(/ /, "", rtf)
+    if (rtf == "n/a" || rtf + 0 < 1.2) { printf "pacing at %d agents: unpaced real-time factor %s < 1.2: no target\n", $2, rtf; next }
+    printf "pacing, paced simulated / wall time at %d agents: %s (target >= 0.98): %s\n", $2, keep, (keep != "n/a" && keep + 0 >= 0.98) ? "pass" : "FAIL" }'
+
+# simulate's per-agent cost from 100 to 10,000 agents.
+echo
+sim=$(VF_WS="$WS" /usr/bin/python3 "$REPO/benchmark/simulate_scaling.py" 100 1000 10000 2>&1 || true)
+echo "$sim"
+echo
+echo "$sim" | awk -F'|' '$2 + 0 == 10000 { r = $6; gsub(/ /, "", r); found = 1
+    printf "simulate, µs per agent-step at 10000 / at 100: %s (target <= 1.3): %s\n", r, (r + 0 > 0 && r + 0 <= 1.3) ? "pass" : "FAIL" }
+  END { if (!found) print "simulate, µs per agent-step at 10000 / at 100: n/a (simulate_scaling.py failed): FAIL" }'
 exit 0
