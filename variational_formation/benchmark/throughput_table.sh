@@ -126,7 +126,7 @@ for n in 100 1000; do has "$n" && record+=("$n"); done
 echo
 rp=$(VF_RP_RECORD="${record[*]:- }" VF_RP_PACE="100 500" VF_BENCH_PORT_BASE="$port_base" \
      "$REPO/benchmark/recording_pacing.sh" 2>/dev/null || true)
-echo "$rp" | grep '^|' || echo "recording_pacing.sh printed no table"
+echo "$rp" | grep -E '^(\||- |Recording)' || echo "recording_pacing.sh printed no table"
 echo
 # Rows of its two tables: | agents | unrecorded | recorded | ratio | exact | and
 # | agents | h | unpaced | unpaced rtf | paced | simulated s | wall s | sim / wall |.
