@@ -7,8 +7,9 @@
 # 1.2e6 / agents) steps (VF_BENCH_STEPS overrides): the same scenario unrecorded, then recorded
 # (record:=true, no size limit) and compared with simulate by benchmark/bag_vs_simulate.py, in
 # VF_RP_ROUNDS rounds (default 3), each an unrecorded run then a recorded one. The row gives the
-# medians of each column and of the rounds' ratios (one round's ratio moves by +-15 % on a 2-core
-# VM); the rounds follow the table. Exact only if every recorded run was.
+# medians of each column and of the rounds' ratios, over the rounds that gave a figure (one round's
+# ratio moves by +-15 % on a 2-core VM); the rounds follow the table. Exact only if every recorded
+# run was.
 # Target: recorded steps/s >= 0.5 x unrecorded (the median ratio), exact.
 #
 # Pacing, per agent count of VF_RP_PACE (default "100 500"): an unpaced run at h = 0.005 s gives
@@ -25,6 +26,7 @@
 #   (VF_BENCH_PORT_BASE, VF_BENCH_PORTS).
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+source "$here/../scripts/common.sh"
 export VF_BENCH_MODES=nodelet VF_BENCH_PORT_BASE="${VF_BENCH_PORT_BASE:-11600}" VF_BENCH_PORTS="${VF_BENCH_PORTS:-100}"
 read -r -a record_counts <<<"${VF_RP_RECORD:-100 1000}"
 read -r -a pace_counts <<<"${VF_RP_PACE:-100 500}"
@@ -40,11 +42,8 @@ run() {
 # Field k of a row.
 field() { echo "$1" | awk -v k="$2" '{ print $k }'; }
 ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (a + 0 > 0 && b + 0 > 0) printf "%.2f", a / b; else print "n/a" }'; }
-# The median of the numbers given (the lower middle one of an even count), or n/a if any is not one.
-median() {
-  if [ $# -eq 0 ] || printf '%s\n' "$@" | grep -qvE '^[0-9]+(\.[0-9]+)?$'; then echo n/a; return; fi
-  printf '%s\n' "$@" | sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'
-}
+# The median of the rounds that gave a number (vf_median), or n/a if none did.
+median() { local m; m=$(vf_median "$@"); echo "${m:-n/a}"; }
 
 echo "load before: $(uptime | sed 's/.*load average: //')"
 echo

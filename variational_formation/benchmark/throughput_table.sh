@@ -46,8 +46,6 @@ counts=("$@"); [ ${#counts[@]} -eq 0 ] && counts=(100 200)
 port_base="${VF_BENCH_PORT_BASE:-11500}"
 rounds="${VF_TABLE_ROUNDS:-3}"
 case "$rounds" in ''|*[!0-9]*|0) echo "throughput_table: VF_TABLE_ROUNDS must be a whole number >= 1, got '$rounds'" >&2; exit 2 ;; esac
-# The median of the numbers given (the lower middle one of an even count); empty if none.
-median() { printf '%s\n' "$@" | grep -E '^[0-9]+$' | sort -n | awk '{ v[NR] = $1 } END { if (NR) print v[int((NR + 1) / 2)] }'; }
 declare -A rate ceiling runs ceilings own owns
 for n in "${counts[@]}"; do
   steps=$(( 1200000 / n > 60000 ? 60000 : (1200000 / n > 1200 ? 1200000 / n : 1200) ))
@@ -68,10 +66,10 @@ for n in "${counts[@]}"; do
         sed -nE 's/.* ([0-9.]+) us per agent-step$/\1/p')
     r_all+=("${r:-failed}") c_all+=("${c:-failed}") o_all+=("${o:-failed}")
   done
-  rate[$n]=$(median "${r_all[@]}")
-  ceiling[$n]=$(median "${c_all[@]}")
+  rate[$n]=$(vf_median "${r_all[@]}")
+  ceiling[$n]=$(vf_median "${c_all[@]}")
   runs[$n]="${r_all[*]}" ceilings[$n]="${c_all[*]}" owns[$n]="${o_all[*]}"
-  own[$n]=$(printf '%s\n' "${o_all[@]}" | grep -E '^[0-9.]+$' | sort -g | awk '{ v[NR] = $1 } END { if (NR) print v[int((NR + 1) / 2)] }')
+  own[$n]=$(vf_median "${o_all[@]}")
 done
 reference=${counts[0]}
 for n in "${counts[@]}"; do [ "$n" = 100 ] && reference=100; done

@@ -110,3 +110,10 @@ vf_free_port() {
   echo "no free port in $base-$(( base + count - 1 ))" >&2
   return 1
 }
+
+# The median of the numbers among the arguments (the lower middle one of an even count); words
+# such as "failed" or "n/a" are left out. Prints nothing if there is no number.
+vf_median() {
+  printf '%s\n' "$@" | { grep -E '^[0-9]+(\.[0-9]+)?$' || true; } | sort -g |
+    awk '{ v[NR] = $1 } END { if (NR) print v[int((NR + 1) / 2)] }'
+}

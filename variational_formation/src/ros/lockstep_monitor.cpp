@@ -91,7 +91,7 @@ void LockstepMonitor::watch() {
     // agent still holds it: catch up from the histories of the agents that are missing.
     if (progress_.state != RunProgress::WAITING && !missing.empty()) {
       const auto held = fetchHistories(missing);
-      for (std::size_t k = 0; k < missing.size(); ++k) referee_->offerHistory(missing[k], heldStates(held[k].states));
+      for (std::size_t k = 0; k < missing.size(); ++k) referee_->offerHistory(missing[k], sharedStates(held[k].states));
       catchUpFromNeighbours(referee_->missing());
       updateProgress();
     }
@@ -139,13 +139,6 @@ bool LockstepMonitor::onHistory(RecallHistory::Request& request, RecallHistory::
   return true;
 }
 
-std::vector<AgentState::ConstPtr> LockstepMonitor::heldStates(const std::vector<AgentState>& states) {
-  std::vector<AgentState::ConstPtr> held;
-  held.reserve(states.size());
-  for (const AgentState& s : states) held.push_back(boost::make_shared<AgentState>(s));
-  return held;
-}
-
 std::vector<RecallHistory::Response> LockstepMonitor::fetchHistories(const std::vector<int>& ids) {
   std::vector<std::string> services;
   std::vector<RecallHistory> calls(ids.size());
@@ -178,7 +171,7 @@ void LockstepMonitor::catchUpFromNeighbours(const std::vector<int>& ids) {
   const std::vector<bool> answered = callAllWithTimeout(services, calls, 2.0);
   const long next = completedStep() + 1;
   for (std::size_t c = 0; c < calls.size(); ++c) {
-    if (answered[c]) referee_->offerHistory(whose[c], heldStates(calls[c].response.states));
+    if (answered[c]) referee_->offerHistory(whose[c], sharedStates(calls[c].response.states));
   }
   const std::vector<int> still = measure().missingAt(next);
   for (int i : ids) {
@@ -200,7 +193,7 @@ void LockstepMonitor::begin() {
     const bool over = h.progress.state == RunProgress::FINISHED || h.progress.state == RunProgress::FAILED;
     answers.push_back({true, static_cast<bool>(h.has_progress), h.progress.completed_step, h.progress.converged_step,
                        over, h.progress.state == RunProgress::FINISHED});
-    histories.push_back(heldStates(h.states));
+    histories.push_back(sharedStates(h.states));
   }
   const Referee::Ready resumed = referee_->step(Referee::Resume{answers, histories});
   // It did not witness a run that is over: neither its outcome nor a new run is its to report.

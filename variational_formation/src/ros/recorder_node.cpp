@@ -139,8 +139,7 @@ void RecorderNode::catchUp() {
   Protocol::HistoriesArrived held{0.0, {}};
   for (std::size_t c = 0; c < calls.size(); ++c) {
     if (!answered[c]) continue;
-    held.answers.emplace_back(agents[c % agents.size()], std::vector<AgentState::ConstPtr>());
-    for (const AgentState& s : calls[c].response.states) held.answers.back().second.push_back(boost::make_shared<AgentState>(s));
+    held.answers.emplace_back(agents[c % agents.size()], sharedStates(calls[c].response.states));
   }
   held.now = ros::WallTime::now().toSec();
   carryOut(protocol_->step(held));

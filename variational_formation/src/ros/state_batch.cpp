@@ -260,4 +260,12 @@ std::vector<BatchSource> batchSources(const ros::NodeHandle& nh, const std::vect
   return sources;
 }
 
+std::vector<variational_formation_msgs::AgentState::ConstPtr> sharedStates(
+    const std::vector<variational_formation_msgs::AgentState>& states) {
+  std::vector<variational_formation_msgs::AgentState::ConstPtr> shared;
+  shared.reserve(states.size());
+  for (const auto& s : states) shared.push_back(boost::make_shared<variational_formation_msgs::AgentState>(s));
+  return shared;
+}
+
 }  // namespace vf

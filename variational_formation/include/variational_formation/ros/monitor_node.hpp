@@ -289,8 +289,6 @@ class LockstepMonitor : public MonitorNode {
   void carryOut(const Referee::Ready& r);
   /// The states agents `ids` hold of themselves (`~history`), in order of `ids`.
   std::vector<RecallHistory::Response> fetchHistories(const std::vector<int>& ids);
-  /// A history's states (a service answer), held as the referee holds them.
-  static std::vector<AgentState::ConstPtr> heldStates(const std::vector<AgentState>& states);
   void catchUpFromNeighbours(const std::vector<int>& ids);
 
   std::unique_ptr<Referee> referee_;

@@ -145,6 +145,11 @@ ros::Subscriber subscribeToBatches(
     ros::NodeHandle& nh, const std::string& topic, uint32_t depth,
     const std::function<void(const ros::MessageEvent<variational_formation_msgs::AgentStates const>&)>& callback);
 
+/// States that came by value (a `~history` answer), each as a shared message, as the monitor and
+/// the recorder hold the states that come by topic or in batches.
+std::vector<variational_formation_msgs::AgentState::ConstPtr> sharedStates(
+    const std::vector<variational_formation_msgs::AgentState>& states);
+
 /// The agent ids in ~agents text ("0 1 2"). @throws InvalidInput naming `parameter`.
 std::vector<int> parseAgentIds(const std::string& list, const std::string& parameter);
 

@@ -244,7 +244,7 @@ class RecorderProtocol {
     if (!(now || first || last || complete >= monitorAllows_ || complete >= progress_.completedStep + kReportEvery)) return;
     progress_.completedStep = complete;
     progress_.state = Progress::State::Running;
-    if (lastStep_ > 0 && complete >= lastStep_) {
+    if (last) {
       r.close = "complete";
       progress_.state = Progress::State::Finished;
     }
