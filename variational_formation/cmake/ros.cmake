@@ -27,7 +27,16 @@ target_sources(variational_formation_ros PRIVATE src/ros/lockstep_monitor.cpp sr
   src/ros/recorder_bag.cpp src/ros/recorder_commands.cpp
   src/ros/sensing_hub.cpp src/ros/service_call.cpp src/ros/state_batch.cpp src/ros/periodic_call.cpp src/ros/pacer.cpp src/ros/trails.cpp)
 add_dependencies(variational_formation_ros ${PROJECT_NAME}_gencfg)
-target_link_libraries(variational_formation_ros ${variational_formation_core_LIBRARIES} ${catkin_LIBRARIES})
+# The bag writer's LZ4 frames (liblz4, Debian's liblz4-dev).
+find_path(VF_LZ4_INCLUDE_DIR lz4frame.h)
+find_library(VF_LZ4_LIBRARY lz4)
+if(NOT VF_LZ4_INCLUDE_DIR OR NOT VF_LZ4_LIBRARY)
+  message(FATAL_ERROR "liblz4 not found (lz4frame.h, liblz4): the recorder's bag writer needs it. Install "
+    "Debian's liblz4-dev (scripts/test.sh installs it from package.xml's key liblz4-dev).")
+endif()
+target_include_directories(variational_formation_ros SYSTEM PRIVATE ${VF_LZ4_INCLUDE_DIR})
+target_link_libraries(variational_formation_ros ${variational_formation_core_LIBRARIES} ${catkin_LIBRARIES}
+  ${VF_LZ4_LIBRARY})
 target_compile_options(variational_formation_ros PRIVATE ${VF_FLAGS})
 add_dependencies(variational_formation_ros ${catkin_EXPORTED_TARGETS})
 

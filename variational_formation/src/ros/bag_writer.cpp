@@ -7,7 +7,7 @@
 #include <cstring>
 #include <stdexcept>
 
-#include <roslz4/lz4s.h>
+#include <lz4frame.h>
 
 namespace vf {
 
@@ -18,13 +18,30 @@ constexpr std::uint8_t kOpMessageData = 0x02, kOpFileHeader = 0x03, kOpIndexData
                        kOpChunkInfo = 0x06, kOpConnection = 0x07;
 constexpr std::uint32_t kFileHeaderLength = 4096;  // the file header record's header and padding
 constexpr std::uint32_t kIndexVersion = 1, kChunkInfoVersion = 1;
-constexpr int kLz4BlockSizeId = 6;  // rosbag's
+
+/// rosbag's LZ4 chunks are LZ4 frames as roslz4 reads them: blocks of at most 1 MB (rosbag's
+/// block size id 6), independent, no block checksums, no content size, and a checksum of the
+/// whole content. liblz4's frame writer makes the same frame roslz4's does, with the same
+/// compressed blocks, about a tenth faster (its content checksum and no staging copy).
+LZ4F_preferences_t lz4Frames() {
+  LZ4F_preferences_t p;
+  std::memset(&p, 0, sizeof p);
+  p.frameInfo.blockSizeID = LZ4F_max1MB;
+  p.frameInfo.blockMode = LZ4F_blockIndependent;
+  p.frameInfo.contentChecksumFlag = LZ4F_contentChecksumEnabled;
+  p.frameInfo.blockChecksumFlag = LZ4F_noBlockChecksum;
+  p.frameInfo.contentSize = 0;
+  p.compressionLevel = 0;  // LZ4's default (fast) mode, as roslz4's LZ4_compress_default
+  return p;
+}
 
 void append(std::vector<std::uint8_t>& out, const void* bytes, std::size_t count) {
   const auto* b = static_cast<const std::uint8_t*>(bytes);
   out.insert(out.end(), b, b + count);
 }
 void appendU32(std::vector<std::uint8_t>& out, std::uint32_t v) { append(out, &v, 4); }
+/// a < b, inline (ros::Time's operator< is a call into librostime, ~2 % of the recorder).
+bool earlier(const ros::Time& a, const ros::Time& b) { return a.sec < b.sec || (a.sec == b.sec && a.nsec < b.nsec); }
 void appendTime(std::vector<std::uint8_t>& out, const ros::Time& t) {
   appendU32(out, t.sec);
   appendU32(out, t.nsec);
@@ -88,6 +105,7 @@ void BagWriter::open(const std::string& path, Compression compression, std::uint
   chunkAge_ = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
       std::chrono::duration<double>(std::max(chunkSeconds, 0.0)));
   fileBytes_ = 0;
+  ++opened_;
   connections_.clear();
   byTopic_.clear();
   index_.clear();
@@ -146,11 +164,12 @@ void BagWriter::appendConnectionRecord(std::vector<std::uint8_t>& out, std::uint
       .text("message_definition", c.definition).done();
 }
 
-std::uint8_t* BagWriter::beginMessage(const std::string& topic, const char* type, const char* md5sum,
-                                      const char* definition, const ros::Time& time, std::uint32_t length) {
+void BagWriter::checkWritable(const std::string& topic, const ros::Time& time) const {
   if (!isOpen()) failed("not open");
-  if (time < ros::TIME_MIN) failed("a message on " + topic + " at time 0 (a bag's times start at 1 ns)");
-  const std::uint32_t conn = connection(topic, type, md5sum, definition);
+  if (time.sec == 0 && time.nsec == 0) failed("a message on " + topic + " at time 0 (a bag's times start at 1 ns)");
+}
+
+std::uint8_t* BagWriter::beginMessage(std::uint32_t conn, const ros::Time& time, std::uint32_t length) {
   if (chunkConnections_.empty()) {
     chunkStart_ = chunkEnd_ = time;
     chunkOpened_ = std::chrono::steady_clock::now();
@@ -158,13 +177,32 @@ std::uint8_t* BagWriter::beginMessage(const std::string& topic, const char* type
   }
   if (index_[conn].empty()) chunkConnections_.push_back(conn);
   index_[conn].push_back(IndexEntry{time, static_cast<std::uint32_t>(chunk_.size())});
-  if (time < chunkStart_) chunkStart_ = time;
-  if (time > chunkEnd_) chunkEnd_ = time;
-  Fields(chunk_).op(kOpMessageData).u32("conn", conn).time("time", time).done();
-  appendU32(chunk_, length);
+  if (earlier(time, chunkStart_)) chunkStart_ = time;
+  if (earlier(chunkEnd_, time)) chunkEnd_ = time;
+  // The record's header (what Fields writes: op, conn, time) and the data's length, in one append.
+  struct __attribute__((packed)) MessageDataHeader {
+    std::uint32_t headerLength = 38;
+    std::uint32_t opLength = 4;
+    char opName[3] = {'o', 'p', '='};
+    std::uint8_t op = kOpMessageData;
+    std::uint32_t connLength = 9;
+    char connName[5] = {'c', 'o', 'n', 'n', '='};
+    std::uint32_t conn;
+    std::uint32_t timeLength = 13;
+    char timeName[5] = {'t', 'i', 'm', 'e', '='};
+    std::uint32_t sec, nsec;
+    std::uint32_t dataLength;
+  };
+  static_assert(sizeof(MessageDataHeader) == 4 + 38 + 4, "a message data record's header and data length");
+  MessageDataHeader header;
+  header.conn = conn;
+  header.sec = time.sec;
+  header.nsec = time.nsec;
+  header.dataLength = length;
   const std::size_t at = chunk_.size();
-  chunk_.resize(at + length);
-  return chunk_.data() + at;
+  chunk_.resize(at + sizeof header + length);
+  std::memcpy(chunk_.data() + at, &header, sizeof header);
+  return chunk_.data() + at + sizeof header;
 }
 
 void BagWriter::endMessage() {
@@ -182,13 +220,13 @@ void BagWriter::writeChunk() {
   std::uint32_t dataLength = size;
   std::string method = "none";
   if (compression_ == Compression::Lz4) {
-    compressed_.resize(size + size / 128 + 1024);
-    unsigned int out = static_cast<unsigned int>(compressed_.size());
-    // An incompressible chunk that outgrows the buffer is written as it is ("none").
-    if (roslz4_buffToBuffCompress(reinterpret_cast<char*>(chunk_.data()), size, compressed_.data(), &out,
-                                  kLz4BlockSizeId) == ROSLZ4_OK) {
+    static const LZ4F_preferences_t frames = lz4Frames();
+    compressed_.resize(LZ4F_compressFrameBound(size, &frames));
+    const std::size_t out = LZ4F_compressFrame(compressed_.data(), compressed_.size(), chunk_.data(), size, &frames);
+    // An error (none is expected with a buffer of the bound's size) writes the chunk plain.
+    if (!LZ4F_isError(out)) {
       data = compressed_.data();
-      dataLength = out;
+      dataLength = static_cast<std::uint32_t>(out);
       method = "lz4";
     }
   }

@@ -12,7 +12,7 @@ namespace vf {
 
 namespace {
 /// Bag time of a message stamped with simulated time t_k (a bag cannot hold time 0).
-ros::Time bagTime(const ros::Time& stamp) { return std::max(stamp, ros::TIME_MIN); }
+ros::Time bagTime(const ros::Time& stamp) { return stamp.sec == 0 && stamp.nsec == 0 ? ros::TIME_MIN : stamp; }
 }  // namespace
 
 void RecorderNode::openPart() {
@@ -54,7 +54,7 @@ void RecorderNode::enforceLimits() {
 }
 
 template <typename M>
-void RecorderNode::write(const std::string& topic, const M& msg, const ros::Time& stamp) {
+void RecorderNode::write(BagWriter::Topic& topic, const M& msg, const ros::Time& stamp) {
   if (!open_) return;
   try {
     bag_.write(topic, bagTime(stamp), msg);
@@ -79,7 +79,7 @@ void RecorderNode::writeStep(const Protocol::Write& w) {
     write(stateTopics_[i], msg, msg.header.stamp);
     tf.transforms.push_back(frameAt(msg.header, frameIds_[i], msg.position));
   }
-  if (!tf.transforms.empty()) write("/tf", tf, tf.transforms.front().header.stamp);
+  if (!tf.transforms.empty()) write(tfTopic_, tf, tf.transforms.front().header.stamp);
   write(statusTopic_, *step.status, step.status->header.stamp);
   if (step.hasMarkers) write(markersTopic_, *step.markers, markersStamp(*step.markers));
 }

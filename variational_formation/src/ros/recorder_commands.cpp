@@ -15,7 +15,7 @@
 namespace vf {
 
 void RecorderNode::setUpCommands(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
-  commandsTopic_ = nh.resolveName("command");
+  commandsTopic_ = BagWriter::Topic(nh.resolveName("command"));
   commandsFile_ = optionalParam<std::string>(pnh, "commands_file", "");
   if (!commandsFile_.empty()) {
     commandsFile_ = outputPath(nh, commandsFile_);

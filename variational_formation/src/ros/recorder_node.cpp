@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include <ros/callback_queue.h>
 
@@ -52,8 +53,8 @@ RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) 
   replaceEarlierBag(path_);
   openPart();
   const std::string prefix = framePrefix(nh);
-  statusTopic_ = nh.resolveName("status");
-  markersTopic_ = nh.resolveName("markers");
+  statusTopic_ = BagWriter::Topic(nh.resolveName("status"));
+  markersTopic_ = BagWriter::Topic(nh.resolveName("markers"));
   // A manager's agents come in its batches (one message per step), the others on their own topics.
   batches_ = batchSources(nh, managers_, n);
   std::vector<bool> batched(static_cast<std::size_t>(n), false);
@@ -65,7 +66,7 @@ RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) 
   }
   for (int i = 0; i < n; ++i) {
     owners_.push_back(agentNodeName(nh, i));
-    stateTopics_.push_back(nh.resolveName("agent_" + std::to_string(i) + "/state"));
+    stateTopics_.emplace_back(nh.resolveName("agent_" + std::to_string(i) + "/state"));
     frameIds_.push_back(prefix + "agent_" + std::to_string(i));
     if (batched[static_cast<std::size_t>(i)]) continue;
     subs_.push_back(nh.subscribe<AgentState>(
@@ -79,10 +80,10 @@ RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) 
       boost::function<void(const ros::MessageEvent<FormationStatus const>&)>(
           [this](const ros::MessageEvent<FormationStatus const>& e) { onStatus(e); }),
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
-  subs_.push_back(nh.subscribe<visualization_msgs::MarkerArray>(
+  subs_.push_back(nh.subscribe<RawMarkers>(
       "markers", kQueue,
-      boost::function<void(const ros::MessageEvent<visualization_msgs::MarkerArray const>&)>(
-          [this](const ros::MessageEvent<visualization_msgs::MarkerArray const>& e) { onMarkers(e); }),
+      boost::function<void(const ros::MessageEvent<RawMarkers const>&)>(
+          [this](const ros::MessageEvent<RawMarkers const>& e) { onMarkers(e); }),
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
   subs_.push_back(nh.subscribe<RunProgress>(
       "progress", 10,
@@ -191,11 +192,19 @@ void RecorderNode::onStatus(const ros::MessageEvent<FormationStatus const>& even
   carryOut(protocol_->step(Protocol::StatusArrived{static_cast<long>(msg->step), msg}));
 }
 
-ros::Time RecorderNode::markersStamp(const visualization_msgs::MarkerArray& msg) {
-  return msg.markers.empty() ? ros::TIME_MIN : msg.markers[0].header.stamp;
+ros::Time RecorderNode::markersStamp(const RawMarkers& msg) {
+  // A MarkerArray is serialised as its number of markers, then each marker, which begins with its
+  // header: seq, then stamp (seconds, nanoseconds), all little-endian uint32.
+  std::uint32_t count = 0, seconds = 0, nanoseconds = 0;
+  if (msg.bytes.size() < 16) return ros::TIME_MIN;
+  std::memcpy(&count, msg.bytes.data(), 4);
+  if (count == 0) return ros::TIME_MIN;
+  std::memcpy(&seconds, msg.bytes.data() + 8, 4);
+  std::memcpy(&nanoseconds, msg.bytes.data() + 12, 4);
+  return ros::Time(seconds, nanoseconds);
 }
 
-void RecorderNode::onMarkers(const ros::MessageEvent<visualization_msgs::MarkerArray const>& event) {
+void RecorderNode::onMarkers(const ros::MessageEvent<RawMarkers const>& event) {
   if (!fromOwner(event, monitor_)) return;
   const auto msg = event.getConstMessage();
   const long step = protocol::stepOfStamp(markersStamp(*msg).toSec(), timeStep_);

@@ -1,6 +1,7 @@
 // The recorder's bag writer (src/ros/bag_writer.cpp), read back by rosbag's own C++ reader: every
 // message, topic, time, type and definition as written, through the index (by topic and by time),
-// compressed or not, in one chunk or many; and a bad use is one line naming the file.
+// compressed or not, in one chunk or many; topics named once, in one file and the next; messages
+// kept as bytes (RawMessage) written byte for byte; and a bad use is one line naming the file.
 #include <gtest/gtest.h>
 
 #include <csignal>
@@ -15,8 +16,11 @@
 #include <rosbag/view.h>
 #include <std_msgs/String.h>
 #include <tf2_msgs/TFMessage.h>
+#include <visualization_msgs/MarkerArray.h>
 
 #include "variational_formation/ros/bag_writer.hpp"
+#include "variational_formation/ros/raw_message.hpp"
+#include "variational_formation/ros/recorder_node.hpp"
 #include "variational_formation_msgs/AgentState.h"
 
 namespace vf {
@@ -160,6 +164,30 @@ TEST_F(BagWriterUse, Lz4ChunksAreSmallerThanPlainOnes) {
   EXPECT_LT(static_cast<double>(bytes[1]), 0.6 * static_cast<double>(bytes[0])) << bytes[1] << " " << bytes[0];
 }
 
+TEST_F(BagWriterUse, AChunkLargerThanAnLz4BlockIsReadBackWhole) {
+  // LZ4 frames hold blocks of at most 1 MB: a 3.5 MB chunk spans four, the last one short.
+  BagWriter bag;
+  bag.open(path("large.bag"), BagWriter::Compression::Lz4, 8u << 20);
+  std::vector<std_msgs::String> texts(7);
+  for (std::size_t k = 0; k < texts.size(); ++k) {
+    texts[k].data.resize(500 * 1000 + k);
+    for (std::size_t c = 0; c < texts[k].data.size(); ++c) texts[k].data[c] = static_cast<char>('a' + (c * c + k) % 23);
+    bag.write("/text", ros::Time(static_cast<double>(k + 1)), texts[k]);
+  }
+  bag.close();
+  EXPECT_LT(fs::file_size(path("large.bag")), 3500u * 1000u);  // compressed
+  rosbag::Bag in(path("large.bag"), rosbag::bagmode::Read);
+  std::size_t k = 0;
+  for (const rosbag::MessageInstance& m : rosbag::View(in)) {
+    const auto text = m.instantiate<std_msgs::String>();
+    ASSERT_NE(text, nullptr);
+    ASSERT_LT(k, texts.size());
+    EXPECT_EQ(text->data, texts[k].data) << "message " << k;
+    ++k;
+  }
+  EXPECT_EQ(k, texts.size());
+}
+
 TEST_F(BagWriterUse, ChunksOlderThanTheirAgeAreWrittenBeforeTheyFill) {
   BagWriter bag;
   bag.open(path("age.bag"), BagWriter::Compression::None, 1u << 30, 0.0);
@@ -172,6 +200,105 @@ TEST_F(BagWriterUse, ChunksOlderThanTheirAgeAreWrittenBeforeTheyFill) {
   bag.close();
   rosbag::Bag in(path("age.bag"), rosbag::bagmode::Read);
   EXPECT_EQ(rosbag::View(in).size(), 128u);
+}
+
+TEST_F(BagWriterUse, ATopicNamedOnceIsFoundAgainInTheNextFile) {
+  // As the recorder writes its split parts: one Topic per stream, bags opened one after another.
+  BagWriter bag;
+  BagWriter::Topic state("/agent_0/state"), text("/text");
+  std_msgs::String t;
+  for (int part = 0; part < 2; ++part) {
+    bag.open(path("part" + std::to_string(part) + ".bag"), BagWriter::Compression::Lz4, 64);
+    for (int k = 1; k <= 20; ++k) {
+      AgentState s;
+      s.step = 100 * part + k;
+      s.position = {1.0 * k, 2.0, 3.0};
+      bag.write(state, ros::Time(k), s);
+      t.data = std::to_string(s.step);
+      bag.write(text, ros::Time(k), t);
+    }
+    bag.close();
+  }
+  for (int part = 0; part < 2; ++part) {
+    rosbag::Bag in(path("part" + std::to_string(part) + ".bag"), rosbag::bagmode::Read);
+    rosbag::View states(in, rosbag::TopicQuery("/agent_0/state"));
+    rosbag::View texts(in, rosbag::TopicQuery("/text"));
+    ASSERT_EQ(states.size(), 20u);
+    ASSERT_EQ(texts.size(), 20u);
+    long k = 1;
+    for (const rosbag::MessageInstance& m : states) {
+      const auto s = m.instantiate<AgentState>();
+      ASSERT_NE(s, nullptr);
+      EXPECT_EQ(s->step, 100 * part + k);
+      EXPECT_EQ(m.getTime(), ros::Time(static_cast<double>(k)));
+      ++k;
+    }
+    k = 1;
+    for (const rosbag::MessageInstance& m : texts) {
+      const auto s = m.instantiate<std_msgs::String>();
+      ASSERT_NE(s, nullptr);
+      EXPECT_EQ(s->data, std::to_string(100 * part + k++));
+    }
+  }
+  // A Topic keeps its type's check: written as another type, it fails as by name.
+  bag.open(path("typed.bag"), BagWriter::Compression::None, 1000);
+  bag.write(text, ros::Time(1), t);
+  try {
+    bag.write(text, ros::Time(2), AgentState());
+    FAIL() << "a topic changed its type";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              path("typed.bag") + ": topic /text was written as std_msgs/String, now as variational_formation_msgs/AgentState");
+  }
+  bag.close();
+}
+
+TEST_F(BagWriterUse, AMessageKeptAsBytesIsWrittenByteForByteAsItsType) {
+  // As roscpp hands a subscriber its message: one serialised message in a stream.
+  visualization_msgs::MarkerArray markers;
+  for (int i = 0; i < 3; ++i) {
+    visualization_msgs::Marker m;
+    m.header.stamp = ros::Time(12, 345678901 + i);
+    m.header.frame_id = "world";
+    m.ns = "ns" + std::to_string(i);
+    m.type = visualization_msgs::Marker::LINE_LIST;
+    m.points.resize(static_cast<std::size_t>(4 * i));
+    for (std::size_t p = 0; p < m.points.size(); ++p) m.points[p].x = 0.5 * static_cast<double>(p) + i;
+    m.text = "step " + std::to_string(i);
+    markers.markers.push_back(m);
+  }
+  const std::uint32_t length = ros::serialization::serializationLength(markers);
+  std::vector<std::uint8_t> wire(length);
+  ros::serialization::OStream out(wire.data(), length);
+  ros::serialization::serialize(out, markers);
+  RawMessage<visualization_msgs::MarkerArray> raw;
+  ros::serialization::IStream in(wire.data(), length);
+  ros::serialization::deserialize(in, raw);
+  EXPECT_EQ(raw.bytes, wire);
+  EXPECT_STREQ(ros::message_traits::md5sum(raw), ros::message_traits::md5sum(markers));
+  EXPECT_STREQ(ros::message_traits::datatype(raw), "visualization_msgs/MarkerArray");
+  // The recorder reads the step's stamp from the bytes: the first marker's, none when empty.
+  EXPECT_EQ(RecorderNode::markersStamp(raw), ros::Time(12, 345678901));
+  EXPECT_EQ(RecorderNode::markersStamp(RawMessage<visualization_msgs::MarkerArray>{{0, 0, 0, 0}}), ros::TIME_MIN);
+  EXPECT_EQ(RecorderNode::markersStamp(RawMessage<visualization_msgs::MarkerArray>{{1, 0, 0, 0, 7}}), ros::TIME_MIN);
+
+  BagWriter bag;
+  bag.open(path("raw.bag"), BagWriter::Compression::Lz4, 1000);
+  bag.write("/markers", ros::Time(1), raw);
+  bag.close();
+  rosbag::Bag bagIn(path("raw.bag"), rosbag::bagmode::Read);
+  rosbag::View view(bagIn);
+  ASSERT_EQ(view.size(), 1u);
+  const rosbag::View::iterator first = view.begin();
+  const rosbag::MessageInstance& m = *first;
+  EXPECT_EQ(m.getDataType(), "visualization_msgs/MarkerArray");
+  EXPECT_EQ(m.getMessageDefinition(), ros::message_traits::definition(markers));
+  const auto back = m.instantiate<visualization_msgs::MarkerArray>();
+  ASSERT_NE(back, nullptr);
+  std::vector<std::uint8_t> again(ros::serialization::serializationLength(*back));
+  ros::serialization::OStream out2(again.data(), static_cast<std::uint32_t>(again.size()));
+  ros::serialization::serialize(out2, *back);
+  EXPECT_EQ(again, wire);
 }
 
 TEST_F(BagWriterUse, BadUsesAreOneLineNamingTheFile) {

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <unordered_map>
 #include <vector>
 
@@ -45,16 +46,44 @@ class BagWriter {
   void open(const std::string& path, Compression compression, std::uint32_t chunkBytes, double chunkSeconds = 1.0);
   bool isOpen() const { return file_ != nullptr; }
 
+  /// A topic named once, for writing to it without looking its name up at every message: its
+  /// connection in the open file is kept with it (and found again in a new file).
+  class Topic {
+   public:
+    explicit Topic(std::string name = "") : name_(std::move(name)) {}
+    const std::string& name() const { return name_; }
+
+   private:
+    friend class BagWriter;
+    std::string name_;
+    std::uint64_t opened_ = 0;      // the open() its connection belongs to (0: none yet)
+    const char* type_ = nullptr;    // the type it was written as there
+    std::uint32_t connection_ = 0;
+  };
+
   /// Appends `msg` on `topic` at bag time `time` (> 0). A topic keeps the type it was first
   /// written with.
   template <typename M>
-  void write(const std::string& topic, const ros::Time& time, const M& msg) {
+  void write(Topic& topic, const ros::Time& time, const M& msg) {
     const std::uint32_t length = ros::serialization::serializationLength(msg);
-    std::uint8_t* data = beginMessage(topic, ros::message_traits::datatype(msg), ros::message_traits::md5sum(msg),
-                                      ros::message_traits::definition(msg), time, length);
+    const char* type = ros::message_traits::datatype(msg);
+    checkWritable(topic.name_, time);
+    if (topic.opened_ != opened_ || topic.type_ != type) {
+      topic.connection_ = connection(topic.name_, type, ros::message_traits::md5sum(msg),
+                                     ros::message_traits::definition(msg));
+      topic.opened_ = opened_;
+      topic.type_ = type;
+    }
+    std::uint8_t* data = beginMessage(topic.connection_, time, length);
     ros::serialization::OStream stream(data, length);
     ros::serialization::serialize(stream, msg);
     endMessage();
+  }
+  /// The same, naming the topic (looked up by name at every message).
+  template <typename M>
+  void write(const std::string& topic, const ros::Time& time, const M& msg) {
+    Topic named(topic);
+    write(named, time, msg);
   }
 
   /// Bytes in the file so far: the chunk being filled is not counted until it is written, so a
@@ -77,12 +106,14 @@ class BagWriter {
     std::vector<std::pair<std::uint32_t, std::uint32_t>> counts;  // (connection, messages)
   };
 
+  /// Throws unless the bag is open and `time` is a bag time (> 0).
+  void checkWritable(const std::string& topic, const ros::Time& time) const;
   std::uint32_t connection(const std::string& topic, const char* type, const char* md5sum, const char* definition);
   /// Appends connection `id`'s record (in its first chunk, and again in the index at the end).
   void appendConnectionRecord(std::vector<std::uint8_t>& out, std::uint32_t id) const;
-  /// Starts a message data record in the chunk, and returns where its `length` bytes go.
-  std::uint8_t* beginMessage(const std::string& topic, const char* type, const char* md5sum, const char* definition,
-                             const ros::Time& time, std::uint32_t length);
+  /// Starts a message data record of connection `conn` in the chunk, and returns where its
+  /// `length` bytes go.
+  std::uint8_t* beginMessage(std::uint32_t conn, const ros::Time& time, std::uint32_t length);
   void endMessage();
   void writeChunk();
   void writeFileHeader(std::uint64_t indexPosition);
@@ -91,6 +122,7 @@ class BagWriter {
   [[noreturn]] void failed(const std::string& what) const;
 
   std::FILE* file_ = nullptr;
+  std::uint64_t opened_ = 0;  // open()s so far: a Topic's connection is valid in the one it was found in
   std::string path_;
   Compression compression_ = Compression::Lz4;
   std::uint32_t chunkBytes_ = 768 * 1024;

@@ -8,6 +8,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include "variational_formation/ros/bag_writer.hpp"
+#include "variational_formation/ros/raw_message.hpp"
 #include "variational_formation/ros/state_batch.hpp"
 #include "variational_formation_msgs/AgentState.h"
 #include "variational_formation_msgs/FormationCommands.h"
@@ -55,11 +56,16 @@ class RecorderNode {
   /// Until the monitor ends the run (or shutdown). @return the exit status.
   int run();
 
+  /// The monitor's marker arrays, stored as they came (RawMessage).
+  using RawMarkers = RawMessage<visualization_msgs::MarkerArray>;
+  /// The stamp of the first marker (that of the step), read from the serialised array; an empty
+  /// (or cut short) array has none: TIME_MIN.
+  static ros::Time markersStamp(const RawMarkers& msg);
+
  private:
-  using Protocol = protocol::RecorderProtocol<AgentState::ConstPtr, FormationStatus::ConstPtr,
-                                              visualization_msgs::MarkerArray::ConstPtr>;
+  using Protocol = protocol::RecorderProtocol<AgentState::ConstPtr, FormationStatus::ConstPtr, RawMarkers::ConstPtr>;
   template <typename M>
-  void write(const std::string& topic, const M& msg, const ros::Time& stamp);
+  void write(BagWriter::Topic& topic, const M& msg, const ros::Time& stamp);
   void onState(int agent, const ros::MessageEvent<AgentState const>& event);
   /// A manager's batch of its agents' states (doc/distributed.md, "Batches").
   void onBatch(std::size_t source, const ros::MessageEvent<variational_formation_msgs::AgentStates const>& event);
@@ -73,11 +79,10 @@ class RecorderNode {
   RunProgress progressMessage(const protocol::Progress& p) const;
   /// The monitor publishes the markers of every marker_every-th step and of the last one.
   bool needsMarkers(long step) const;
-  static ros::Time markersStamp(const visualization_msgs::MarkerArray& msg);
   /// Asks the protocol whether to catch up, and fetches the histories it names.
   void catchUp();
   void onStatus(const ros::MessageEvent<FormationStatus const>& event);
-  void onMarkers(const ros::MessageEvent<visualization_msgs::MarkerArray const>& event);
+  void onMarkers(const ros::MessageEvent<RawMarkers const>& event);
   void onMonitorProgress(const ros::MessageEvent<RunProgress const>& event);
   void close(const std::string& how);
   /// Ends the recording and tells the monitor, which ends the run as failed, naming the reason.
@@ -96,8 +101,10 @@ class RecorderNode {
   ros::NodeHandle nh_;
   BagWriter bag_;
   BagWriter::Compression compression_ = BagWriter::Compression::Lz4;  // ~compression
-  std::string path_, monitor_, statusTopic_, markersTopic_, commandsTopic_;
-  std::vector<std::string> stateTopics_, frameIds_;  // by agent
+  std::string path_, monitor_;
+  BagWriter::Topic statusTopic_, markersTopic_, commandsTopic_, tfTopic_{"/tf"};
+  std::vector<BagWriter::Topic> stateTopics_;  // by agent
+  std::vector<std::string> frameIds_;          // by agent
   std::vector<ros::Subscriber> subs_;
   ros::Publisher progressPub_;
   long lastStep_ = 0;  // the scenario's steps (0: unbounded)
