@@ -240,6 +240,27 @@ TEST_F(BagWriterUse, ATopicNamedOnceIsFoundAgainInTheNextFile) {
       EXPECT_EQ(s->data, std::to_string(100 * part + k++));
     }
   }
+  // One Topic in two writers at once, whose connections are numbered in opposite orders.
+  BagWriter first, second;
+  first.open(path("first.bag"), BagWriter::Compression::None, 1000);
+  second.open(path("second.bag"), BagWriter::Compression::None, 1000);
+  t.data = "a";
+  first.write(text, ros::Time(1), t);
+  second.write(state, ros::Time(1), AgentState());
+  second.write(text, ros::Time(2), t);
+  first.write(state, ros::Time(2), AgentState());
+  first.close();
+  second.close();
+  for (const char* name : {"first.bag", "second.bag"}) {
+    rosbag::Bag in(path(name), rosbag::bagmode::Read);
+    EXPECT_EQ(rosbag::View(in, rosbag::TopicQuery("/text")).size(), 1u) << name;
+    for (const rosbag::MessageInstance& m : rosbag::View(in, rosbag::TopicQuery("/text"))) {
+      EXPECT_NE(m.instantiate<std_msgs::String>(), nullptr) << name;
+    }
+    for (const rosbag::MessageInstance& m : rosbag::View(in, rosbag::TopicQuery("/agent_0/state"))) {
+      EXPECT_NE(m.instantiate<AgentState>(), nullptr) << name;
+    }
+  }
   // A Topic keeps its type's check: written as another type, it fails as by name.
   bag.open(path("typed.bag"), BagWriter::Compression::None, 1000);
   bag.write(text, ros::Time(1), t);

@@ -56,8 +56,9 @@ class BagWriter {
    private:
     friend class BagWriter;
     std::string name_;
-    std::uint64_t opened_ = 0;      // the open() its connection belongs to (0: none yet)
-    const char* type_ = nullptr;    // the type it was written as there
+    const BagWriter* writer_ = nullptr;  // the writer and the open() its connection belongs to
+    std::uint64_t opened_ = 0;
+    const char* type_ = nullptr;         // the type it was written as there
     std::uint32_t connection_ = 0;
   };
 
@@ -68,9 +69,10 @@ class BagWriter {
     const std::uint32_t length = ros::serialization::serializationLength(msg);
     const char* type = ros::message_traits::datatype(msg);
     checkWritable(topic.name_, time);
-    if (topic.opened_ != opened_ || topic.type_ != type) {
+    if (topic.writer_ != this || topic.opened_ != opened_ || topic.type_ != type) {
       topic.connection_ = connection(topic.name_, type, ros::message_traits::md5sum(msg),
                                      ros::message_traits::definition(msg));
+      topic.writer_ = this;
       topic.opened_ = opened_;
       topic.type_ = type;
     }
