@@ -3,6 +3,7 @@
 #include "variational_formation/ros/bag_writer.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
@@ -98,14 +99,15 @@ void BagWriter::open(const std::string& path, Compression compression, std::uint
                      double chunkSeconds) {
   if (isOpen()) failed("already open (writing " + path_ + ")");
   path_ = path;
-  file_ = std::fopen(path.c_str(), "wb");
-  if (file_ == nullptr) failed(std::strerror(errno));
+  stream_ = std::fopen(path.c_str(), "wb");
+  if (stream_ == nullptr) failed(std::strerror(errno));
   compression_ = compression;
   chunkBytes_ = std::max<std::uint32_t>(chunkBytes, 1);
   chunkAge_ = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
       std::chrono::duration<double>(std::max(chunkSeconds, 0.0)));
   fileBytes_ = 0;
-  ++opened_;
+  static std::atomic<std::uint64_t> files{0};
+  file_ = ++files;
   connections_.clear();
   byTopic_.clear();
   index_.clear();
@@ -116,10 +118,10 @@ void BagWriter::open(const std::string& path, Compression compression, std::uint
   try {
     put(kVersionLine, sizeof(kVersionLine) - 1);
     writeFileHeader(0);  // rewritten at close with the index's position and the counts
-    if (std::fflush(file_) != 0) failed(std::strerror(errno));
+    if (std::fflush(stream_) != 0) failed(std::strerror(errno));
   } catch (...) {
-    std::fclose(file_);
-    file_ = nullptr;
+    std::fclose(stream_);
+    stream_ = nullptr;
     throw;
   }
 }
@@ -166,7 +168,7 @@ void BagWriter::appendConnectionRecord(std::vector<std::uint8_t>& out, std::uint
 
 void BagWriter::checkWritable(const std::string& topic, const ros::Time& time) const {
   if (!isOpen()) failed("not open");
-  if (time.sec == 0 && time.nsec == 0) failed("a message on " + topic + " at time 0 (a bag's times start at 1 ns)");
+  if (time.isZero()) failed("a message on " + topic + " at time 0 (a bag's times start at 1 ns)");
 }
 
 std::uint8_t* BagWriter::beginMessage(std::uint32_t conn, const ros::Time& time, std::uint32_t length) {
@@ -255,7 +257,7 @@ void BagWriter::writeChunk() {
   }
   put(record_.data(), record_.size());
   // Into the file now: a writer killed later loses only the chunk it was filling.
-  if (std::fflush(file_) != 0) failed(std::strerror(errno));
+  if (std::fflush(stream_) != 0) failed(std::strerror(errno));
   chunks_.push_back(std::move(info));
   chunkConnections_.clear();
   chunk_.clear();
@@ -279,22 +281,22 @@ void BagWriter::close() {
       }
     }
     put(record_.data(), record_.size());
-    if (std::fseek(file_, sizeof(kVersionLine) - 1, SEEK_SET) != 0) failed(std::strerror(errno));
+    if (std::fseek(stream_, sizeof(kVersionLine) - 1, SEEK_SET) != 0) failed(std::strerror(errno));
     const std::uint64_t end = fileBytes_;
     writeFileHeader(indexPosition);
     fileBytes_ = end;
   } catch (...) {
-    std::fclose(file_);
-    file_ = nullptr;
+    std::fclose(stream_);
+    stream_ = nullptr;
     throw;
   }
-  const int closed = std::fclose(file_);
-  file_ = nullptr;
+  const int closed = std::fclose(stream_);
+  stream_ = nullptr;
   if (closed != 0) failed(std::strerror(errno));
 }
 
 void BagWriter::put(const void* bytes, std::size_t count) {
-  if (count > 0 && std::fwrite(bytes, 1, count, file_) != count) failed(std::strerror(errno));
+  if (count > 0 && std::fwrite(bytes, 1, count, stream_) != count) failed(std::strerror(errno));
   fileBytes_ += count;
 }
 

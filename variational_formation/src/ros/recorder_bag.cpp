@@ -12,7 +12,7 @@ namespace vf {
 
 namespace {
 /// Bag time of a message stamped with simulated time t_k (a bag cannot hold time 0).
-ros::Time bagTime(const ros::Time& stamp) { return stamp.sec == 0 && stamp.nsec == 0 ? ros::TIME_MIN : stamp; }
+ros::Time bagTime(const ros::Time& stamp) { return stamp.isZero() ? ros::TIME_MIN : stamp; }
 }  // namespace
 
 void RecorderNode::openPart() {

@@ -44,7 +44,7 @@ class BagWriter {
   /// (uncompressed; at least 1), or once it has been open `chunkSeconds` of wall time (the age
   /// is looked at every 16th message): a killed writer loses about its last chunkSeconds.
   void open(const std::string& path, Compression compression, std::uint32_t chunkBytes, double chunkSeconds = 1.0);
-  bool isOpen() const { return file_ != nullptr; }
+  bool isOpen() const { return stream_ != nullptr; }
 
   /// A topic named once, for writing to it without looking its name up at every message: its
   /// connection in the open file is kept with it (and found again in a new file).
@@ -56,9 +56,8 @@ class BagWriter {
    private:
     friend class BagWriter;
     std::string name_;
-    const BagWriter* writer_ = nullptr;  // the writer and the open() its connection belongs to
-    std::uint64_t opened_ = 0;
-    const char* type_ = nullptr;         // the type it was written as there
+    std::uint64_t file_ = 0;         // the file its connection belongs to (BagWriter::file_; 0: none)
+    const char* type_ = nullptr;     // the type it was written as there
     std::uint32_t connection_ = 0;
   };
 
@@ -69,11 +68,10 @@ class BagWriter {
     const std::uint32_t length = ros::serialization::serializationLength(msg);
     const char* type = ros::message_traits::datatype(msg);
     checkWritable(topic.name_, time);
-    if (topic.writer_ != this || topic.opened_ != opened_ || topic.type_ != type) {
+    if (topic.file_ != file_ || topic.type_ != type) {
       topic.connection_ = connection(topic.name_, type, ros::message_traits::md5sum(msg),
                                      ros::message_traits::definition(msg));
-      topic.writer_ = this;
-      topic.opened_ = opened_;
+      topic.file_ = file_;
       topic.type_ = type;
     }
     std::uint8_t* data = beginMessage(topic.connection_, time, length);
@@ -123,8 +121,10 @@ class BagWriter {
   void put(const void* bytes, std::size_t count);
   [[noreturn]] void failed(const std::string& what) const;
 
-  std::FILE* file_ = nullptr;
-  std::uint64_t opened_ = 0;  // open()s so far: a Topic's connection is valid in the one it was found in
+  std::FILE* stream_ = nullptr;
+  /// The open file, numbered across every writer of the process (0: none), so that a Topic's
+  /// connection is used only in the file it was found in.
+  std::uint64_t file_ = 0;
   std::string path_;
   Compression compression_ = Compression::Lz4;
   std::uint32_t chunkBytes_ = 768 * 1024;
