@@ -22,8 +22,10 @@
 # Every run, the lockstep one and the ceiling, takes 1200000 / agents steps, within 1200 to 60000
 # (12000 at 100 agents, about 3 s): long enough that the start (the first status, the connections) is not
 # what is measured. (Until issue 34's last round: 120000 / agents lockstep steps, 0.3 s at 100.)
-# Each count runs VF_TABLE_ROUNDS times (default 3), the lockstep run and the ceiling in turn, and
-# the table gives the median of each; the rounds' figures follow the table. (On 2 cores one run's
+# Each count runs VF_TABLE_ROUNDS times (default 3), the lockstep run and the ceiling in turn; a
+# round runs every count once, and the rounds follow one another. The table gives the median of
+# each figure, and of each ratio over the rounds: a ratio is taken within a round (two runs
+# minutes apart), then its median. The rounds' figures and ratios follow the table. (On 2 cores one run's
 # figure depends on where the scheduler puts the agents' thread and the monitor: the same build
 # gave 2357 to 4149 steps/s at 100 agents in five runs, the ceiling 2484 to 3814 at 200.)
 # Targets: agent-steps/s at 200 >= 0.8 x at 100 and at 1000 >= 0.7 x at 100 ("flat per-agent
@@ -46,11 +48,13 @@ counts=("$@"); [ ${#counts[@]} -eq 0 ] && counts=(100 200)
 port_base="${VF_BENCH_PORT_BASE:-11500}"
 rounds="${VF_TABLE_ROUNDS:-3}"
 case "$rounds" in ''|*[!0-9]*|0) echo "throughput_table: VF_TABLE_ROUNDS must be a whole number >= 1, got '$rounds'" >&2; exit 2 ;; esac
-declare -A rate ceiling runs ceilings own owns
-for n in "${counts[@]}"; do
-  steps=$(( 1200000 / n > 60000 ? 60000 : (1200000 / n > 1200 ? 1200000 / n : 1200) ))
-  r_all=() c_all=() o_all=()
-  for ((round = 1; round <= rounds; ++round)); do
+declare -A rate ceiling runs ceilings own owns r_at c_at
+# Rounds outside, counts inside: every count's k-th run comes within minutes of the others', so
+# that a machine whose speed drifts over the hour moves every count alike (issue 34's last table:
+# the 100-agent rounds alone spread from 6191 to 10083 steps/s).
+for ((round = 1; round <= rounds; ++round)); do
+  for n in "${counts[@]}"; do
+    steps=$(( 1200000 / n > 60000 ? 60000 : (1200000 / n > 1200 ? 1200000 / n : 1200) ))
     r=$(VF_BENCH_STEPS="$steps" VF_BENCH_MODES=nodelet VF_BENCH_PORT_BASE="$port_base" VF_BENCH_PORTS=90 "$REPO/scripts/benchmark_ros.sh" "$n" 2>/dev/null |
         awk -v n="$n" '$1 == n && $2 == "nodelet" { print $4; exit }')
     port="$(vf_free_port $((port_base + 90)) 10)"
@@ -64,28 +68,51 @@ for n in "${counts[@]}"; do
     wait "$master" 2>/dev/null || true
     o=$("$WS/devel/lib/variational_formation/benchmark_protocol" --agents "$n" --steps "$steps" 2>/dev/null |
         sed -nE 's/.* ([0-9.]+) us per agent-step$/\1/p')
-    r_all+=("${r:-failed}") c_all+=("${c:-failed}") o_all+=("${o:-failed}")
+    # shellcheck disable=SC2034  # read through round_ratios' namerefs
+    r_at[$n,$round]="${r:-failed}" c_at[$n,$round]="${c:-failed}"
+    runs[$n]+="${runs[$n]:+ }${r:-failed}" ceilings[$n]+="${ceilings[$n]:+ }${c:-failed}" owns[$n]+="${owns[$n]:+ }${o:-failed}"
   done
-  rate[$n]=$(vf_median "${r_all[@]}")
-  ceiling[$n]=$(vf_median "${c_all[@]}")
-  runs[$n]="${r_all[*]}" ceilings[$n]="${c_all[*]}" owns[$n]="${o_all[*]}"
-  own[$n]=$(vf_median "${o_all[@]}")
+done
+for n in "${counts[@]}"; do
+  # shellcheck disable=SC2086  # the rounds' figures, one word each
+  rate[$n]=$(vf_median ${runs[$n]}) ceiling[$n]=$(vf_median ${ceilings[$n]}) own[$n]=$(vf_median ${owns[$n]})
 done
 reference=${counts[0]}
 for n in "${counts[@]}"; do [ "$n" = 100 ] && reference=100; done
 # a / b to two decimals, or n/a when either is missing or zero.
 ratio() { awk -v a="${1:-0}" -v b="${2:-0}" 'BEGIN { if (a > 0 && b > 0) printf "%.2f", a / b; else print "n/a" }'; }
+# round_ratios X N WN Y M WM: each round's X[N] x WN / (Y[M] x WM), X and Y the name of r_at
+# (lockstep) or c_at (ceiling), as words, "n/a" for a round where either run failed.
+round_ratios() {
+  local -n x=$1 y=$4
+  local k out=()
+  for ((k = 1; k <= rounds; ++k)); do out+=("$(ratio "$(awk -v a="${x[$2,$k]:-0}" -v w="$3" 'BEGIN { print a * w }')" \
+                                                     "$(awk -v a="${y[$5,$k]:-0}" -v w="$6" 'BEGIN { print a * w }')")"); done
+  echo "${out[*]}"
+}
+# The median of round_ratios over the rounds that gave one, or n/a: a ratio of two runs minutes
+# apart, not of two medians taken at different times.
+per_round() {
+  local m
+  # shellcheck disable=SC2046  # one word per round
+  m=$(vf_median $(round_ratios "$@"))
+  echo "${m:-n/a}"
+}
 echo "| agents | steps/s | agent-steps/s | µs per agent-step | ratio to $reference | ceiling, steps/s | ceiling ratio to $reference | lockstep / ceiling |"
 echo "| --- | --- | --- | --- | --- | --- | --- | --- |"
 for n in "${counts[@]}"; do
   r=${rate[$n]:-} c=${ceiling[$n]:-}
   per=$(awk -v r="${r:-0}" -v n="$n" 'BEGIN { if (r > 0) printf "%.1f", 1e6 / (r * n); else print "n/a" }')
-  echo "| $n | ${r:-failed} | $(( ${r:-0} * n )) | $per | $(ratio $(( ${r:-0} * n )) $(( ${rate[$reference]:-0} * reference ))) |" \
-       "${c:-failed} | $(ratio $(( ${c:-0} * n )) $(( ${ceiling[$reference]:-0} * reference ))) | $(ratio "$r" "$c") |"
+  echo "| $n | ${r:-failed} | $(( ${r:-0} * n )) | $per | $(per_round r_at "$n" "$n" r_at "$reference" "$reference") |" \
+       "${c:-failed} | $(per_round c_at "$n" "$n" c_at "$reference" "$reference") | $(per_round r_at "$n" 1 c_at "$n" 1) |"
 done
 echo
-echo "Each figure is the median of $rounds rounds; the rounds, steps/s:"
-for n in "${counts[@]}"; do echo "- $n agents: lockstep ${runs[$n]}; ceiling ${ceilings[$n]}; own step (µs) ${owns[$n]}"; done
+echo "Steps/s are medians of $rounds rounds; each ratio is the median of the rounds' own ratios (one run"
+echo "of each count per round, the rounds one after another). The rounds, steps/s, then ratios:"
+for n in "${counts[@]}"; do
+  echo "- $n agents: lockstep ${runs[$n]}; ceiling ${ceilings[$n]}; own step (µs) ${owns[$n]};" \
+       "ratio to $reference $(round_ratios r_at "$n" "$n" r_at "$reference" "$reference"); lockstep / ceiling $(round_ratios r_at "$n" 1 c_at "$n" 1)"
+done
 echo
 echo "The agents' own step alone (benchmark_protocol, median µs per agent-step), and the most lockstep / ceiling can be:"
 for n in "${counts[@]}"; do
@@ -105,15 +132,15 @@ if has 100; then
   for n in 200 1000; do
     has "$n" || continue
     t=$([ "$n" = 200 ] && echo 0.8 || echo 0.7)
-    target "flat per-agent cost, agent-steps/s at $n / at 100" "$(ratio $(( ${rate[$n]:-0} * n )) $(( ${rate[100]:-0} * 100 )))" "$t"
+    target "flat per-agent cost, agent-steps/s at $n / at 100" "$(per_round r_at "$n" "$n" r_at 100 100)" "$t"
   done
 fi
 for n in 100 200; do
-  has "$n" && target "near the ceiling, lockstep / ceiling at $n" "$(ratio "${rate[$n]}" "${ceiling[$n]}")" 0.7
+  has "$n" && target "near the ceiling, lockstep / ceiling at $n" "$(per_round r_at "$n" 1 c_at "$n" 1)" 0.7
 done
 if has 100; then
   for n in 200 1000; do
-    has "$n" && echo "ceiling's own flatness, agent-steps/s at $n / at 100: $(ratio $(( ${ceiling[$n]:-0} * n )) $(( ${ceiling[100]:-0} * 100 )))"
+    has "$n" && echo "ceiling's own flatness, agent-steps/s at $n / at 100: $(per_round c_at "$n" "$n" c_at 100 100)"
   done
 fi
 [ "${VF_TABLE_ALL:-1}" = 1 ] || exit 0

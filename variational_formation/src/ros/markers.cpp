@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <utility>
 
+#include "variational_formation_core/common/invalid_input.hpp"
 #include "variational_formation_core/model/spatial_grid.hpp"
 
 namespace vf {
@@ -244,6 +245,15 @@ Marker statusText(const FormationSnapshot& s, int agents, const Ghost& ghostAt, 
 }
 
 }  // namespace
+
+long markerEvery(long requested, double timeStep) {
+  if (requested < 0) {
+    throw InvalidInput("~marker_every: must be >= 0 (0: the markers of one step in every 0.02 s of simulated time), got " +
+                       std::to_string(requested));
+  }
+  if (requested > 0) return requested;
+  return std::max(1L, static_cast<long>(std::ceil(kMarkerPeriod / timeStep - 1e-9)));
+}
 
 long allMarkersEvery(int trailStride, double timeStep) {
   const long perRedraw = static_cast<long>(std::ceil(kAllMarkersPeriod / timeStep - 1e-9));

@@ -21,8 +21,6 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh, bool timed) 
   worldFrame_ = worldFrame(pnh);
   trailLength_ = optionalParam(pnh, "trail_length", 100);
   window_ = optionalParam(pnh, "window", 100);
-  markerEvery_ = optionalParam(pnh, "marker_every", 1);
-  if (markerEvery_ < 1) throw InvalidInput("~marker_every: must be >= 1, got " + std::to_string(markerEvery_));
   recorderParam_ = optionalParam<std::string>(pnh, "recorder", "");
   resultFile_ = outputPath(nh, optionalParam<std::string>(pnh, "result_file", ""));
   waitForViewer_ = optionalParam(pnh, "wait_for_viewer", false);
@@ -40,6 +38,7 @@ MonitorNode::MonitorNode(ros::NodeHandle& nh, ros::NodeHandle& pnh, bool timed) 
   }
   recording_ = !recorderParam_.empty();
   scenario_ = loadScenario(path_);
+  markerEvery_ = markerEvery(optionalParam(pnh, "marker_every", 0), scenario_.timeStep);
   const int n = scenario_.agentCount();
   trails_ = Trails(n, trailLength_);
   allMarkersEvery_ = allMarkersEvery(trails_.stride(), scenario_.timeStep);

@@ -10,6 +10,7 @@
 #include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/frames.hpp"
+#include "variational_formation/ros/markers.hpp"
 #include "variational_formation/ros/participant_names.hpp"
 #include "variational_formation/ros/progress_message.hpp"
 #include "variational_formation/ros/service_call.hpp"
@@ -30,8 +31,7 @@ RecorderNode::RecorderNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) 
   path_ = outputPath(nh, requiredParam<std::string>(pnh, "bag"));
   monitor_ = participantName(nh, optionalParam<std::string>(pnh, "monitor", "monitor"));
   managers_ = agentManagers(nh, pnh);
-  markerEvery_ = optionalParam(pnh, "marker_every", 1);
-  if (markerEvery_ < 1) throw InvalidInput("~marker_every: must be >= 1, got " + std::to_string(markerEvery_));
+  markerEvery_ = markerEvery(optionalParam(pnh, "marker_every", 0), scenario.timeStep);
   lastStep_ = scenario.steps;
   timeStep_ = scenario.timeStep;
   const int n = scenario.agentCount();

@@ -393,6 +393,8 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
         cases = (("monitor", ["_trail_length:=abc"], "~trail_length: expected an integer"),
                  ("monitor", ["_trail_length:=1"], "~trail_length: must be >= 2"),
                  ("monitor", ["_window:=0"], "~window: must be >= 1"),
+                 ("monitor", ["_marker_every:=-1"], "~marker_every: must be >= 0"),
+                 ("recorder", ["_bag:=/tmp/vf_probe.bag", "_marker_every:=-2"], "~marker_every: must be >= 0"),
                  ("recorder", ["_bag:=/tmp/vf_probe.bag", "_max_size:=-1"], "~max_size: must be in [0, 1e9) MB"),
                  ("recorder", ["_bag:=/tmp/vf_probe.bag", "_compression:=zip"], "~compression: must be lz4 or none, got 'zip'"),
                  ("agent", ["_id:=1", "_real_time_factor:=inf"], "~real_time_factor"),

@@ -3,12 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include <ros/serialization.h>
 #include <ros/time.h>
 
+#include "variational_formation_core/common/invalid_input.hpp"
 #include "variational_formation/ros/markers.hpp"
 
 namespace vf {
@@ -240,6 +242,25 @@ TEST_F(MarkersTest, WholeArraysComeAsOftenAsTheTrailsGrowAndAtMost25ASimulatedSe
   EXPECT_EQ(allMarkersEvery(17, 0.005), 17);  // 100 agents: the trails' stride
   EXPECT_EQ(allMarkersEvery(50, 0.001), 50);
   EXPECT_EQ(allMarkersEvery(1, 0.0001), 400);
+}
+
+TEST_F(MarkersTest, MarkersComeEveryRequestedStepOrFiftyASimulatedSecond) {
+  // 0 (the default): one step in every 0.02 s of simulated time, at least every step.
+  EXPECT_EQ(markerEvery(0, 0.005), 4);     // 0.02 s / 0.005 s
+  EXPECT_EQ(markerEvery(0, 0.014), 2);     // ceil(1.43): hexagon.yaml
+  EXPECT_EQ(markerEvery(0, 0.02), 1);      // exactly one step
+  EXPECT_EQ(markerEvery(0, 0.1), 1);       // steps longer than the period: every step
+  EXPECT_EQ(markerEvery(0, 0.0001628), 123);  // ceil(122.85)
+  // A requested k is kept, whatever h.
+  EXPECT_EQ(markerEvery(1, 0.005), 1);
+  EXPECT_EQ(markerEvery(10, 0.1), 10);
+  try {
+    markerEvery(-1, 0.005);
+    FAIL() << "a negative ~marker_every was taken";
+  } catch (const InvalidInput& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "~marker_every: must be >= 0 (0: the markers of one step in every 0.02 s of simulated time), got -1");
+  }
 }
 
 }  // namespace

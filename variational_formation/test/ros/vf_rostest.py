@@ -199,7 +199,9 @@ class RunChecks:
         differ = sorted(key for key, msgs in rec.states.items() if any(list(m.position) != expected[key] for m in msgs))
         self.assertEqual(differ[:5], [], f"{len(differ)} recorded states differ from simulate")
 
-    def check_recording(self, rec, scenario, expected, ns="/formation"):
+    def check_recording(self, rec, scenario, expected, ns="/formation", marker_every=0):
+        """`marker_every` as the run's `~marker_every`: 0 (the default) is one step in every 0.02 s of
+        simulated time (doc/ros_api.md, the monitor's `~marker_every`)."""
         n, steps, h = scenario["n"], int(scenario["steps"]), float(scenario["time_step"])
         self.check_each_step_once(rec, n, steps)
         mismatches = 0
@@ -211,8 +213,11 @@ class RunChecks:
                 self.assertLess(abs(m.header.stamp.to_sec() - k * h), 1.01e-9 + 1e-15 * k * h)
                 self.assertAlmostEqual(m.time, k * h, delta=1e-12 * (1 + k * h))
         self.assertEqual(mismatches, 0, f"{mismatches} recorded positions differ from simulate")
-        # Markers of every step, once (the monitor republishes those the recorder has not confirmed).
-        self.assertEqual(sorted(round(t / h) for t in rec.marker_stamps), list(range(steps + 1)))
+        # Markers of every marker_every-th step and of the last, once each (the monitor republishes
+        # those the recorder has not confirmed).
+        every = marker_every or max(1, math.ceil(0.02 / h - 1e-9))
+        self.assertEqual(sorted(round(t / h) for t in rec.marker_stamps),
+                         [k for k in range(steps + 1) if k % every == 0 or k == steps])
         # tf: every agent's frame, prefixed by the namespace, at every step, stamped t_k.
         prefix = ns.lstrip("/") + "/" if ns.strip("/") else ""
         for i in range(n):

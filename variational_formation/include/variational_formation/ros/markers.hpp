@@ -33,6 +33,19 @@ enum class MarkerParts { All, Moving };
 /// often as rviz redraws (doc/benchmarks.md, "Recording and pacing").
 constexpr double kAllMarkersPeriod = 0.04;
 
+/// Simulated seconds between two marker arrays at the default `~marker_every` (0): 50 arrays a
+/// simulated second, about as often as a screen shows a picture (doc/benchmarks.md, "Markers at a
+/// simulated-time rate").
+constexpr double kMarkerPeriod = 0.02;
+
+/**
+ * Steps between two marker arrays, the monitor's and the recorder's `~marker_every` made one
+ * number: `requested` >= 1 as it is; 0 (the default) ceil(kMarkerPeriod / h), at least 1.
+ * @param timeStep h [s] (> 0).
+ * @throws InvalidInput ("~marker_every: ...") for a negative `requested`.
+ */
+long markerEvery(long requested, double timeStep);
+
 /**
  * Steps between two arrays with every marker (the trails and the ghost, the bulk of an array):
  * max(stride, ceil(kAllMarkersPeriod / h)), so that an array with trails comes about as often as
