@@ -24,13 +24,19 @@ std::string worldFrame(const ros::NodeHandle& pnh) {
 geometry_msgs::TransformStamped frameAt(const std_msgs::Header& header, const std::string& child,
                                         const std::vector<double>& position) {
   geometry_msgs::TransformStamped t;
+  setFrameAt(t, header, child, position);
+  return t;
+}
+
+void setFrameAt(geometry_msgs::TransformStamped& t, const std_msgs::Header& header, const std::string& child,
+                const std::vector<double>& position) {
   t.header = header;
   t.child_frame_id = child;
   t.transform.translation.x = position.size() > 0 ? position[0] : 0.0;
   t.transform.translation.y = position.size() > 1 ? position[1] : 0.0;
   t.transform.translation.z = position.size() > 2 ? position[2] : 0.0;
+  t.transform.rotation.x = t.transform.rotation.y = t.transform.rotation.z = 0.0;
   t.transform.rotation.w = 1.0;
-  return t;
 }
 
 }  // namespace vf

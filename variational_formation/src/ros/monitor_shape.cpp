@@ -15,7 +15,7 @@ void MonitorNode::noteShape(const FormationSnapshot& s) {
 
 ShapeOutcome MonitorNode::agentsVerdict() const {
   ShapeFindings f = lastShape_;
-  // Beyond 200 agents the shape error skips steps (FormationSnapshot::shape): the verdict needs it.
+  // Beyond 50 agents the shape error skips steps (FormationSnapshot::shape): the verdict needs it.
   if (std::isnan(f.shapeError) && lastPositions_.size() > 0) {
     f.shapeError = measure().formation().shapeError(lastPositions_, lastScale_);
   }

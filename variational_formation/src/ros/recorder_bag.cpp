@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include <tf2_msgs/TFMessage.h>
-
 #include "variational_formation/ros/frames.hpp"
 #include "variational_formation/ros/recorder_node.hpp"
 
@@ -71,15 +69,15 @@ void RecorderNode::writeStep(const Protocol::Write& w) {
   const Protocol::Step& step = w.step;
   if (w.commands > 0) writeListedCommands(w.commands, step.step);
   // The step's transforms in one /tf message, as a broadcaster of many frames sends them: a
-  // bag message costs the same whatever it holds, and 1000 agents wrote 2000 a step.
-  tf2_msgs::TFMessage tf;
-  tf.transforms.reserve(step.states.size());
+  // bag message costs the same whatever it holds, and 1000 agents wrote 2000 a step. The message
+  // is reused, so its frame names keep their memory from step to step.
+  tf_.transforms.resize(step.states.size());
   for (std::size_t i = 0; i < step.states.size(); ++i) {
     const AgentState& msg = *step.states[i];
     write(stateTopics_[i], msg, msg.header.stamp);
-    tf.transforms.push_back(frameAt(msg.header, frameIds_[i], msg.position));
+    setFrameAt(tf_.transforms[i], msg.header, frameIds_[i], msg.position);
   }
-  if (!tf.transforms.empty()) write(tfTopic_, tf, tf.transforms.front().header.stamp);
+  if (!tf_.transforms.empty()) write(tfTopic_, tf_, tf_.transforms.front().header.stamp);
   write(statusTopic_, *step.status, step.status->header.stamp);
   if (step.hasMarkers) write(markersTopic_, *step.markers, markersStamp(*step.markers));
 }

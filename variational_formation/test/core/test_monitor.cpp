@@ -5,10 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "test_support.hpp"
 #include "variational_formation_core/agents/formation_monitor.hpp"
 #include "variational_formation_core/integrators/step_metrics.hpp"
+#include "variational_formation_core/model/shape_outcome.hpp"
 
 namespace vf {
 namespace {
@@ -24,6 +27,35 @@ FormationSnapshot measureAt(FormationMonitor& monitor, long k, const Positions& 
   const std::vector<FormationSnapshot> done = monitor.takeCompleted();
   EXPECT_EQ(done.size(), 1u);
   return done.empty() ? FormationSnapshot() : done.front();
+}
+
+TEST(FormationMonitor, EachCongruentStretchSaysWhetherItIsTheMirrorImage) {
+  // The hexagon at rest, as its mirror image, stretched (not congruent), then as desired: each
+  // congruent stretch carries its own answer at every step (the test runs at a stretch's first
+  // step; the others keep it), and the findings agree with findShape's own test.
+  const Scenario s = loadScenario(test::configPath("hexagon"));
+  const Formation f = makeFormation(s);
+  Positions mirror = f.desiredShape();
+  mirror.row(1) *= -1.0;
+  const Positions desired = f.desiredShape();
+  const Positions stretched = 1.5 * desired;
+  FormationMonitor monitor(s);
+  monitor.startAt(1, -1);  // at rest from step 1 on (step 0 takes the scenario's velocities)
+  const std::vector<std::pair<const Positions*, bool>> run = {
+      {&mirror, true}, {&mirror, true}, {&mirror, true}, {&stretched, false}, {&desired, false}, {&desired, false}};
+  long k = 1;
+  for (const auto& [q, mirrored] : run) {
+    const FormationSnapshot snap = measureAt(monitor, k, *q, *q);
+    EXPECT_EQ(snap.converged, q != &stretched) << "step " << k;
+    EXPECT_EQ(snap.shape.mirrored, mirrored) << "step " << k;
+    const ShapeFindings alone = findShape(f, *q, Positions::Zero(2, 6), 1.0, snap.converged, 0.01, 0.1);  // the defaults
+    EXPECT_EQ(snap.shape.mirrored, alone.mirrored) << "step " << k;
+    ++k;
+  }
+  // A monitor restarted inside a congruent stretch tests it again.
+  FormationMonitor restarted(s);
+  restarted.startAt(k, 5);
+  EXPECT_TRUE(measureAt(restarted, k, mirror, mirror).shape.mirrored);
 }
 
 TEST(FormationMonitorUnderCommands, MeasuresAsSimulateDoesAndConvergesWhileMoving) {

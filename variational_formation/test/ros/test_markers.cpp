@@ -11,6 +11,7 @@
 #include <ros/time.h>
 
 #include "variational_formation_core/common/invalid_input.hpp"
+#include "variational_formation/ros/frames.hpp"
 #include "variational_formation/ros/markers.hpp"
 
 namespace vf {
@@ -261,6 +262,21 @@ TEST_F(MarkersTest, MarkersComeEveryRequestedStepOrFiftyASimulatedSecond) {
     EXPECT_EQ(std::string(e.what()),
               "~marker_every: must be >= 0 (0: the markers of one step in every 0.02 s of simulated time), got -1");
   }
+}
+
+TEST(Frames, AReusedTransformIsWrittenWhole) {
+  std_msgs::Header header;
+  header.stamp = ros::Time(1.25);
+  header.frame_id = "world";
+  const geometry_msgs::TransformStamped fresh = frameAt(header, "formation/agent_12", {1.5, -2.0});
+  // A transform left over from another frame, rotated, 3-D, with a longer name.
+  geometry_msgs::TransformStamped reused = frameAt(header, "a_much_longer_frame_name_than_before", {7.0, 8.0, 9.0});
+  reused.header.seq = 41;
+  reused.transform.rotation.x = reused.transform.rotation.y = reused.transform.rotation.z = 0.5;
+  setFrameAt(reused, header, "formation/agent_12", {1.5, -2.0});
+  EXPECT_EQ(reused, fresh);
+  EXPECT_EQ(reused.transform.translation.z, 0.0);  // planar: z = 0
+  EXPECT_EQ(reused.transform.rotation.w, 1.0);
 }
 
 }  // namespace

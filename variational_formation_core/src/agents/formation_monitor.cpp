@@ -66,6 +66,7 @@ void FormationMonitor::startAt(long step, long congruentSince) {
   pending_.clear();
   next_ = step;
   congruentSince_ = congruentSince;
+  mirrorTested_ = false;  // a restarted monitor tests the stretch it resumes in again
 }
 
 std::vector<int> FormationMonitor::missingAt(long step) const {
@@ -120,7 +121,12 @@ FormationSnapshot FormationMonitor::measureStep(long step, const Positions& qPre
   s.converged = congruence_.check(formation_, q, v, scale);
   // The O(n^2) shape error at most a 50-agent cost per step (NaN between).
   const bool measured = shapeErrorMeasuredAt(step, formation_.agentCount(), scenario_.steps);
-  s.shape = findShape(formation_, q, v, scale, s.converged, tolerance_, maxSpeed_, measured);
+  // The mirror test once per congruent stretch: its answer holds while the shape stays congruent.
+  const bool mirrorKnown = s.converged && congruentSince_ >= 0 && mirrorTested_;
+  s.shape = findShape(formation_, q, v, scale, s.converged, tolerance_, maxSpeed_, measured,
+                      mirrorKnown ? &mirrored_ : nullptr);
+  mirrorTested_ = s.converged;
+  mirrored_ = s.shape.mirrored;
   if (!s.converged) {
     congruentSince_ = -1;
   } else if (congruentSince_ < 0) {

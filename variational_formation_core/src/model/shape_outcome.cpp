@@ -9,7 +9,8 @@
 namespace vf {
 
 ShapeFindings findShape(const Formation& formation, const Positions& q, const Velocities& v, double scale,
-                        bool congruent, double tolerance, double maxSpeed, bool withShapeError) {
+                        bool congruent, double tolerance, double maxSpeed, bool withShapeError,
+                        const bool* knownMirror) {
   ShapeFindings f;
   f.shapeError = withShapeError ? formation.shapeError(q, scale) : std::numeric_limits<double>::quiet_NaN();
   f.maxEdgeError = formation.maxDistanceError(q, scale);
@@ -17,7 +18,7 @@ ShapeFindings findShape(const Formation& formation, const Positions& q, const Ve
   f.edgesConverged = formation.allSlowerThan(v, maxSpeed) && formation.edgesWithin(q, tolerance, scale);
   // A congruent shape cannot change hands without passing through a flat one, which is not
   // congruent: while it stays congruent this answer holds.
-  f.mirrored = congruent && isMirrorImage(q, formation.desiredShape(), tolerance);
+  f.mirrored = congruent && (knownMirror ? *knownMirror : isMirrorImage(q, formation.desiredShape(), tolerance));
   return f;
 }
 

@@ -25,5 +25,9 @@ std::string worldFrame(const ros::NodeHandle& pnh);
 /// place that builds an agent's or a robot's transform.
 geometry_msgs::TransformStamped frameAt(const std_msgs::Header& header, const std::string& child,
                                         const std::vector<double>& position);
+/// frameAt written into `t`, every field: a transform reused step after step keeps its strings'
+/// memory (the recorder's /tf of every agent at every step).
+void setFrameAt(geometry_msgs::TransformStamped& t, const std_msgs::Header& header, const std::string& child,
+                const std::vector<double>& position);
 
 }  // namespace vf

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include <ros/ros.h>
+#include <tf2_msgs/TFMessage.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include "variational_formation/ros/bag_writer.hpp"
@@ -105,6 +106,7 @@ class RecorderNode {
   BagWriter::Topic statusTopic_, markersTopic_, commandsTopic_, tfTopic_{"/tf"};
   std::vector<BagWriter::Topic> stateTopics_;  // by agent
   std::vector<std::string> frameIds_;          // by agent
+  tf2_msgs::TFMessage tf_;                     // a step's /tf, reused (writeStep)
   std::vector<ros::Subscriber> subs_;
   ros::Publisher progressPub_;
   long lastStep_ = 0;  // the scenario's steps (0: unbounded)

@@ -24,8 +24,9 @@ struct FormationSnapshot {
   bool converged = false;              ///< congruent (with s d_ij, moving as commanded) at this step
   long convergedStep = -1;             ///< first step of the current congruent stretch
   /// Shape error over all pairs, edges converged, mirror image (shape_outcome.hpp). The O(n^2)
-  /// shape error is measured every step up to 200 agents, beyond that every ceil((n/200)^2)
-  /// steps and at the last one (NaN between), so that it never costs more per step than at 200.
+  /// shape error is measured when shapeErrorMeasuredAt says (every step up to 50 agents, beyond
+  /// that every ceil((n/50)^2) steps and at the last one; NaN between). The mirror test runs at
+  /// the first step of a congruent stretch, whose answer the later steps of the stretch keep.
   ShapeFindings shape;
 };
 
@@ -89,6 +90,8 @@ class FormationMonitor {
   std::map<long, Pending> pending_;
   long next_ = 0;
   long congruentSince_ = -1;
+  bool mirrorTested_ = false;  // the mirror test ran in the current congruent stretch; its answer:
+  bool mirrored_ = false;
   Vector3 p0_, a0_;
 };
 

@@ -21,9 +21,13 @@ struct ShapeFindings {
  * CongruenceTracker's, the same as congruenceSlack >= 0 with all speeds below maxSpeed). The
  * mirror test runs only on a congruent shape. O(n^2) for the shape error, O(n + |E|) without it
  * (withShapeError false: shapeError is NaN).
+ * @param knownMirror the mirror test's answer at an earlier step of the same congruent stretch,
+ *        taken as it is (a congruent shape cannot change hands without passing through a flat
+ *        one, which is not congruent); nullptr: test it. Ignored when not congruent.
  */
 ShapeFindings findShape(const Formation& formation, const Positions& q, const Velocities& v, double scale,
-                        bool congruent, double tolerance, double maxSpeed, bool withShapeError = true);
+                        bool congruent, double tolerance, double maxSpeed, bool withShapeError = true,
+                        const bool* knownMirror = nullptr);
 
 /**
  * Whether a run measures the O(n^2) shape error at `step`: at most a 50-agent cost per step on
