@@ -48,7 +48,7 @@ counts=("$@"); [ ${#counts[@]} -eq 0 ] && counts=(100 200)
 port_base="${VF_BENCH_PORT_BASE:-11500}"
 rounds="${VF_TABLE_ROUNDS:-3}"
 case "$rounds" in ''|*[!0-9]*|0) echo "throughput_table: VF_TABLE_ROUNDS must be a whole number >= 1, got '$rounds'" >&2; exit 2 ;; esac
-declare -A rate ceiling runs ceilings own owns r_at c_at
+declare -A rate ceiling own r_at c_at o_at
 # Rounds outside, counts inside: every count's k-th run comes within minutes of the others', so
 # that a machine whose speed drifts over the hour moves every count alike (issue 34's last table:
 # the 100-agent rounds alone spread from 6191 to 10083 steps/s).
@@ -68,14 +68,20 @@ for ((round = 1; round <= rounds; ++round)); do
     wait "$master" 2>/dev/null || true
     o=$("$WS/devel/lib/variational_formation/benchmark_protocol" --agents "$n" --steps "$steps" 2>/dev/null |
         sed -nE 's/.* ([0-9.]+) us per agent-step$/\1/p')
-    # shellcheck disable=SC2034  # read through round_ratios' namerefs
-    r_at[$n,$round]="${r:-failed}" c_at[$n,$round]="${c:-failed}"
-    runs[$n]+="${runs[$n]:+ }${r:-failed}" ceilings[$n]+="${ceilings[$n]:+ }${c:-failed}" owns[$n]+="${owns[$n]:+ }${o:-failed}"
+    # shellcheck disable=SC2034  # read through namerefs (rounds_of, round_ratios)
+    r_at[$n,$round]="${r:-failed}" c_at[$n,$round]="${c:-failed}" o_at[$n,$round]="${o:-failed}"
   done
 done
+# rounds_of X N: the rounds' figures of count N in X (r_at, c_at or o_at), as words.
+rounds_of() {
+  local -n x=$1
+  local k out=()
+  for ((k = 1; k <= rounds; ++k)); do out+=("${x[$2,$k]}"); done
+  echo "${out[*]}"
+}
 for n in "${counts[@]}"; do
-  # shellcheck disable=SC2086  # the rounds' figures, one word each
-  rate[$n]=$(vf_median ${runs[$n]}) ceiling[$n]=$(vf_median ${ceilings[$n]}) own[$n]=$(vf_median ${owns[$n]})
+  # shellcheck disable=SC2046  # the rounds' figures, one word each
+  rate[$n]=$(vf_median $(rounds_of r_at "$n")) ceiling[$n]=$(vf_median $(rounds_of c_at "$n")) own[$n]=$(vf_median $(rounds_of o_at "$n"))
 done
 reference=${counts[0]}
 for n in "${counts[@]}"; do [ "$n" = 100 ] && reference=100; done
@@ -110,7 +116,7 @@ echo
 echo "Steps/s are medians of $rounds rounds; each ratio is the median of the rounds' own ratios (one run"
 echo "of each count per round, the rounds one after another). The rounds, steps/s, then ratios:"
 for n in "${counts[@]}"; do
-  echo "- $n agents: lockstep ${runs[$n]}; ceiling ${ceilings[$n]}; own step (µs) ${owns[$n]};" \
+  echo "- $n agents: lockstep $(rounds_of r_at "$n"); ceiling $(rounds_of c_at "$n"); own step (µs) $(rounds_of o_at "$n");" \
        "ratio to $reference $(round_ratios r_at "$n" "$n" r_at "$reference" "$reference"); lockstep / ceiling $(round_ratios r_at "$n" 1 c_at "$n" 1)"
 done
 echo

@@ -244,6 +244,12 @@ Marker statusText(const FormationSnapshot& s, int agents, const Ghost& ghostAt, 
   return text;
 }
 
+/// Whole steps of h that cover `period` seconds, at least 1 (a period that is a whole number of
+/// steps up to round-off gives that number).
+long stepsCovering(double period, double timeStep) {
+  return std::max(1L, static_cast<long>(std::ceil(period / timeStep - 1e-9)));
+}
+
 }  // namespace
 
 long markerEvery(long requested, double timeStep) {
@@ -251,13 +257,11 @@ long markerEvery(long requested, double timeStep) {
     throw InvalidInput("~marker_every: must be >= 0 (0: the markers of one step in every 0.02 s of simulated time), got " +
                        std::to_string(requested));
   }
-  if (requested > 0) return requested;
-  return std::max(1L, static_cast<long>(std::ceil(kMarkerPeriod / timeStep - 1e-9)));
+  return requested > 0 ? requested : stepsCovering(kMarkerPeriod, timeStep);
 }
 
 long allMarkersEvery(int trailStride, double timeStep) {
-  const long perRedraw = static_cast<long>(std::ceil(kAllMarkersPeriod / timeStep - 1e-9));
-  return std::max({static_cast<long>(trailStride), perRedraw, 1L});
+  return std::max(static_cast<long>(trailStride), stepsCovering(kAllMarkersPeriod, timeStep));
 }
 
 visualization_msgs::MarkerArray makeMarkers(const FormationSnapshot& s, const Formation& formation,
