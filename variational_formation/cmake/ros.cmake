@@ -141,6 +141,8 @@ if(CATKIN_ENABLE_TESTING)
   add_rostest(test/ros/local_delivery.test)
   # SIGKILL to the nodelet manager of every agent during a recorded run: test/ros/nodelet_fault.test.
   add_rostest(test/ros/nodelet_fault.test ARGS seed:=3)
+  # SIGKILLs to one of two unpaced agent_managers: steps lost everywhere are computed again.
+  add_rostest(test/ros/shard_fault.test ARGS seed:=1)
   # Lockstep with the safety filter on (test/ros/safety_run.test, doc/distributed.md "Sensing"):
   # the bag equals simulate, unpaced, and with a SIGKILL while the victim's filter binds.
   add_rostest(test/ros/safety_run.test ARGS rate:=0)

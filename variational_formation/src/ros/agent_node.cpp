@@ -126,6 +126,7 @@ void AgentNode::carryOut(const Protocol::Ready& ready) {
   if (!ready.over.empty()) ROS_INFO("%s: %s", name_.c_str(), ready.over.c_str());
   if (ready.resumedAt >= 0) ROS_INFO("%s: resumed at step %ld, the holders' newer state of mine", name_.c_str(), ready.resumedAt);
   if (ready.recallAgain) recallAgain();
+  if (!ready.askNeighbourHistories.empty()) askNeighbourHistories(ready.askNeighbourHistories);
   if (ready.wakeWhenSensed) wakeWhenSensed();
   if (ready.wakeAfter > 0.0) paceFor(ready.wakeAfter);
 }

@@ -10,7 +10,9 @@
 #include <ros/callback_queue_interface.h>
 
 #include "variational_formation/ros/pacer.hpp"
+#include "variational_formation/ros/participant_names.hpp"
 #include "variational_formation/ros/recalled.hpp"
+#include "variational_formation/ros/service_call.hpp"
 
 namespace vf {
 
@@ -48,6 +50,52 @@ void AgentNode::recallAgain() {
       if (!*alive) return;
       if (r.step > agent().step()) ROS_INFO("%s: %s holds my step %ld", name_.c_str(), r.from.c_str(), r.step);
       carryOut(protocol_->step(Protocol::Recalled{r.step, r.found.position, r.found.previous_position}));
+    }), reinterpret_cast<uint64_t>(this));
+  }).detach();
+}
+
+void AgentNode::askNeighbourHistories(const std::vector<int>& ids) {
+  // Who holds neighbour j's recent states: j itself, and j's neighbours (the states of j they
+  // accepted); not this agent, which has just started.
+  std::vector<std::string> services;
+  std::vector<RecallHistory> calls;
+  std::vector<int> whose;
+  const Scenario& scenario = agent().scenario();
+  for (int j : ids) {
+    std::vector<int> holders{j};
+    for (const auto& e : scenario.edges) {
+      const int k = e.first == j ? e.second : e.second == j ? e.first : -1;
+      if (k >= 0 && k != agent().id()) holders.push_back(k);
+    }
+    for (int k : holders) {
+      services.push_back(agentNodeName(nh_, k) + "/history");
+      calls.emplace_back();
+      calls.back().request.id = j;
+      whose.push_back(j);
+    }
+  }
+  const std::shared_ptr<bool> alive = alive_;
+  ros::CallbackQueueInterface* queue = nh_.getCallbackQueue();
+  // Not on the agent's queue: the holders may be served by this process's other threads.
+  std::thread([this, alive, queue, services, calls, whose]() mutable {
+    const std::vector<bool> answered = callAllWithTimeout(services, calls, 2.0);
+    auto histories = std::make_shared<Protocol::NeighbourHistories>();
+    std::size_t holders = 0;
+    for (std::size_t c = 0; c < calls.size(); ++c) {
+      if (!answered[c]) continue;
+      ++holders;
+      for (const AgentState& s : calls[c].response.states) {
+        // Only states of the agent asked about: a holder answers for that agent alone.
+        if (static_cast<int>(s.id) == whose[c]) {
+          histories->states.push_back({whose[c], boost::make_shared<const AgentState>(s)});
+        }
+      }
+    }
+    queue->addCallback(boost::make_shared<QueuedCall>([this, alive, histories, holders, asked = calls.size()] {
+      if (!*alive) return;
+      ROS_INFO("%s: %zu of %zu holders answered, with %zu states", name_.c_str(), holders, asked,
+               histories->states.size());
+      carryOut(protocol_->step(*histories));
     }), reinterpret_cast<uint64_t>(this));
   }).detach();
 }

@@ -128,17 +128,18 @@ class World {
   void killAgent(int i, std::mt19937& rng, double lossChance) {
     trace("kill agent " + std::to_string(i));
     agents_[static_cast<std::size_t>(i)].reset();
+    latched_.erase(i);  // its latched topic went with it: a new subscriber gets nothing until it publishes again
     // Each connection from it loses a random tail of its queue (with probability lossChance).
     std::bernoulli_distribution lost(lossChance);
     std::map<int, bool> tailLost;  // by receiver
     for (std::size_t k = inFlight_.size(); k-- > 0;) {
-      const Message& m = inFlight_[k];
-      if (m.to == i) {
+      const int to = inFlight_[k].to;  // a copy: lose(k) erases the message
+      if (to == i) {
         lose(k);
-      } else if (m.kind == Message::Kind::State && m.from == i) {
-        if (!tailLost.count(m.to)) tailLost[m.to] = lost(rng);
-        if (tailLost[m.to]) lose(k);
-        tailLost[m.to] = tailLost[m.to] && lost(rng);
+      } else if (inFlight_[k].kind == Message::Kind::State && inFlight_[k].from == i) {
+        if (!tailLost.count(to)) tailLost[to] = lost(rng);
+        if (tailLost[to]) lose(k);
+        tailLost[to] = tailLost[to] && lost(rng);
       }
     }
   }
@@ -194,6 +195,8 @@ class World {
   long recorderReports() const { return recorderReports_; }
   /// How often a restarted agent asked its holders again (Ready::recallAgain).
   long recalledAgain() const { return recalledAgain_; }
+  /// How often a restarted agent asked for its neighbours' histories (Ready::askNeighbourHistories).
+  long historiesAsked() const { return historiesAsked_; }
   /// The newest step any live agent computed.
   long newestAgentStep() const {
     long newest = -1;
@@ -269,6 +272,23 @@ class World {
       trace("agent " + std::to_string(i) + " recalls again");
       AgentProtocol::Recalled answer;
       if (const std::optional<State> found = recall(i)) answer = {found->step, found->position, found->previous_position};
+      carryOut(i, agents_[static_cast<std::size_t>(i)]->step(answer));
+    }
+    if (!ready.askNeighbourHistories.empty()) {  // as AgentNode asks: each one's own and its neighbours' `~history`
+      ++historiesAsked_;
+      trace("agent " + std::to_string(i) + " asks for its neighbours' histories");
+      AgentProtocol::NeighbourHistories answer;
+      for (int j : ready.askNeighbourHistories) {
+        std::vector<int> holders{j};
+        for (const Neighbour& k : formation_.neighbours(j)) {
+          if (k.agent != i) holders.push_back(k.agent);
+        }
+        for (int h : holders) {
+          if (const AgentProtocol* a = agents_[static_cast<std::size_t>(h)].get()) {
+            for (const State& st : held(*a, j)) answer.states.push_back({j, std::make_shared<const State>(st)});
+          }
+        }
+      }
       carryOut(i, agents_[static_cast<std::size_t>(i)]->step(answer));
     }
   }
@@ -470,6 +490,7 @@ class World {
   AgentProtocol::Ready readyForStates_;  // agentGotState's, reused
   std::map<int, State> latched_;  // each agent's newest published state
   long recalledAgain_ = 0;
+  long historiesAsked_ = 0;
   std::optional<Progress> latchedProgress_;
   std::unique_ptr<Referee> monitor_;
   Recorder recorder_;

@@ -112,6 +112,10 @@ class AgentNode {
   /// Protocol's Ready::recallAgain: askHolders() from a thread of its own, the answer then
   /// given to the protocol on this agent's queue (src/ros/agent_recovery.cpp).
   void recallAgain();
+  /// Protocol's Ready::askNeighbourHistories: `~history` of each neighbour j in `ids` from j and
+  /// j's neighbours, from a thread of its own; their states of j then go to the protocol on this
+  /// agent's queue (src/ros/agent_recovery.cpp).
+  void askNeighbourHistories(const std::vector<int>& ids);
   bool onRecall(RecallState::Request& request, RecallState::Response& response);
   bool onHistory(RecallHistory::Request& request, RecallHistory::Response& response);
   const LockstepAgent& agent() const { return protocol_->agent(); }

@@ -34,6 +34,11 @@ namespace vf::protocol {
  *   its first update, means that neighbour used a newer state of it (the dead incarnation's last,
  *   which reached it after the holders were asked). It asks the holders again (Ready::recallAgain),
  *   resumes from their answer (Recalled), and then takes the states it kept.
+ * - Lost everywhere: when the holders have nothing newer, our next state may exist nowhere (an
+ *   agent_manager killed with it in its unsent batch, while a neighbour's state computed from it
+ *   had left on its own topic). Then it asks the holders of each neighbour that is ahead for that
+ *   neighbour's states after our step (Ready::askNeighbourHistories), and computes the lost
+ *   steps again from them (NeighbourHistories): the same operands, so the same states.
  *
  * StatePtr points to the caller's state message (fields id, step, position, previous_position);
  * it is built by `make` and kept as it is, so histories serve exactly what was published.
@@ -59,6 +64,9 @@ class AgentProtocol {
     /// Ask the holders again where to resume (as at a restart) and give their answer to step(Recalled).
     bool recallAgain = false;
     long resumedAt = -1;            ///< >= 0: it resumed at this step on a Recalled answer
+    /// Neighbours past our step + 1 whose older states we need: ask each one's holders (itself and
+    /// its neighbours, `~history` with its id) and give the states to step(NeighbourHistories).
+    std::vector<int> askNeighbourHistories;
 
     /// Back to "nothing to do", keeping the buffers (every field above, as initialised).
     void clear() {
@@ -71,6 +79,7 @@ class AgentProtocol {
       wakeAfter = -1.0;
       recallAgain = false;
       resumedAt = -1;
+      askNeighbourHistories.clear();
     }
   };
 
@@ -91,6 +100,12 @@ class AgentProtocol {
   };
   /// The pacing timer or the shared board says the agent may go on.
   struct Wake {};
+  /// The answer to Ready::askNeighbourHistories: the states of those neighbours their holders
+  /// hold, in any order, repeats allowed; the caller checked that each is the state of the
+  /// neighbour whose history it asked for (`topic` = that neighbour's id).
+  struct NeighbourHistories {
+    std::vector<StateArrived> states;
+  };
   /// The holders' answer after Ready::recallAgain: the newest state of this agent they hold.
   struct Recalled {
     long step = -1;  ///< -1: none beyond step 0
@@ -141,6 +156,15 @@ class AgentProtocol {
       // before the dead incarnation's last states reach them). The next newer state asks again.
       r.note = "the holders' newest state of this agent (step " + std::to_string(e.step) +
                ") is not past step " + std::to_string(agent_.step()) + "; waiting for a newer one";
+      if (!ahead_.empty() && !agent_.advancedSinceResume() && historiesAskedAt_ < askedAt_) {
+        // Our next state may exist nowhere: compute it again from the neighbours' older states.
+        historiesAskedAt_ = askedAt_;
+        historiesOf_.clear();  // a newer state ahead: their holders may hold more by now
+        for (const StateArrived& k : ahead_) askHistoryOf(r, k.topic);
+        r.note = "no holder has a state of this agent past step " + std::to_string(agent_.step()) + ", though " +
+                 aheadList() + " computed from one: asking their holders for their states from step " +
+                 std::to_string(agent_.step()) + " on, to compute the lost steps again";
+      }
       return r;
     }
     try {
@@ -154,6 +178,28 @@ class AgentProtocol {
     std::vector<StateArrived> kept;
     kept.swap(ahead_);
     for (const StateArrived& s : kept) offer(r, s);
+    advance(r);
+    return r;
+  }
+
+  /// Takes the states of the neighbours that are ahead from their holders' histories, and uses
+  /// each once the agent reaches its step (the lost steps are computed again, exactly).
+  Ready step(const NeighbourHistories& e) {
+    Ready r;
+    fetchingHistories_ = false;
+    std::size_t kept = 0;
+    for (const StateArrived& s : e.states) {
+      if (s.state && s.state->step >= agent_.step()) {
+        backfill_.push_back(s);
+        ++kept;
+      }
+    }
+    std::stable_sort(backfill_.begin(), backfill_.end(),
+                     [](const StateArrived& a, const StateArrived& b) { return a.state->step < b.state->step; });
+    r.note = kept == 0 ? "the holders of " + aheadList() + " hold none of their states from step " +
+                             std::to_string(agent_.step()) + " on; waiting"
+                       : std::to_string(kept) + " state(s) of " + aheadList() +
+                             " from their holders, each used when this agent reaches its step";
     advance(r);
     return r;
   }
@@ -213,13 +259,15 @@ class AgentProtocol {
   /// What it waits for, in words. @param monitor the monitor's node name.
   std::string waitingFor(const std::string& monitor) const {
     if (!failure_.empty()) return "the monitor to end the run (" + failure_ + ")";
-    if (!ahead_.empty()) {
+    if (!ahead_.empty() && !agent_.advancedSinceResume()) {
       const StateArrived& newest = *std::max_element(ahead_.begin(), ahead_.end(), [](const StateArrived& a, const StateArrived& b) {
         return a.state->step < b.state->step;
       });
       return "a newer state of its own: agent_" + std::to_string(newest.topic) + " is at step " +
              std::to_string(newest.state->step) + ", past step " + std::to_string(agent_.step()) + " + 1" +
-             (recalling_ ? " (asking the holders again)" : " (the holders asked had none newer)");
+             (recalling_ ? " (asking the holders again)"
+                         : fetchingHistories_ ? " (none held one; asking " + aheadList() + "'s holders for their older states)"
+                                              : " (the holders asked had none newer)");
     }
     if (agent_.finished()) return "the monitor to end the run (last step " + std::to_string(agent_.step()) + " done)";
     if (agent_.step() >= allowedStep_) {
@@ -298,10 +346,75 @@ class AgentProtocol {
       recalling_ = true;
       askedAt_ = e.state->step;
       r.recallAgain = true;
+    } else if (historiesAskedAt_ >= 0) {
+      askHistoryOf(r, e.topic);  // another neighbour ahead, after the holders had nothing newer
     }
   }
-  /// Computes every step the gates allow (the flow gate is this loop's condition).
+  /// Asks (once per neighbour) for neighbour j's states held in its holders' histories.
+  void askHistoryOf(Ready& r, int j) {
+    if (std::find(historiesOf_.begin(), historiesOf_.end(), j) != historiesOf_.end()) return;
+    historiesOf_.push_back(j);
+    fetchingHistories_ = true;
+    r.askNeighbourHistories.push_back(j);
+  }
+  /// Computes every step the gates allow, then offers the states kept for later that became usable.
   void advance(Ready& r) {
+    advanceSteps(r);
+    if (!backfill_.empty() || !ahead_.empty()) releaseKept(r);
+  }
+  /// After a resume only: offers the kept states whose step has come, in step order.
+  __attribute__((noinline, cold)) void releaseKept(Ready& r) {
+    if (releasing_) return;
+    // Offers below advance the agent again (offer -> advance): this loop alone releases.
+    releasing_ = true;
+    for (bool offered = true; offered;) {
+      offered = false;
+      const long usable = agent_.step() + 1;
+      if (!backfill_.empty() && backfill_.front().state->step <= usable) {
+        const StateArrived s = backfill_.front();
+        backfill_.erase(backfill_.begin());
+        offerQuietly(r, s);
+        offered = true;
+        continue;
+      }
+      if (!agent_.advancedSinceResume()) continue;
+      // Kept while resumed behind; once it moved on, each is taken when its step comes.
+      for (auto it = ahead_.begin(); it != ahead_.end(); ++it) {
+        if (it->state->step <= usable) {
+          const StateArrived s = *it;
+          ahead_.erase(it);
+          offer(r, s);
+          offered = true;
+          break;
+        }
+      }
+    }
+    releasing_ = false;
+  }
+  /// A state from a holder's history: one that is of no use (older than the one held, or a
+  /// repeat) is no fault of its sender's, so nothing is reported.
+  void offerQuietly(Ready& r, const StateArrived& e) {
+    const auto& msg = *e.state;
+    if (static_cast<long>(msg.id) != e.topic) return;
+    try {
+      if (agent_.receive(e.topic, msg.step, msg.position, msg.previous_position) == LockstepAgent::Receipt::Accepted) {
+        const std::vector<int>& ids = agent_.neighbourIds();
+        const auto k = static_cast<std::size_t>(std::find(ids.begin(), ids.end(), e.topic) - ids.begin());
+        if (k < ids.size()) neighbourHistory_[k].push_back(e.state);
+        advance(r);
+      }
+    } catch (const std::exception& ex) {
+      r.dropped = std::string("a state from a holder's history: ") + ex.what();
+    }
+  }
+  /// "agent_3, agent_5": the senders of the states kept past our step + 1.
+  std::string aheadList() const {
+    std::string s;
+    for (const StateArrived& k : ahead_) s += (s.empty() ? "" : ", ") + std::string("agent_") + std::to_string(k.topic);
+    return s.empty() ? "the neighbours" : s;
+  }
+  /// Computes every step the gates allow (the flow gate is this loop's condition).
+  void advanceSteps(Ready& r) {
     while (exitStatus_ < 0 && failure_.empty() && !agent_.finished() && agent_.step() < allowedStep_ &&
            commandsHeld_ >= commandsCounted_) {
       if (!agent_.ready()) {
@@ -376,6 +489,11 @@ class AgentProtocol {
   std::vector<StateArrived> ahead_;  // states past our step + 1, kept while the holders are asked again
   bool recalling_ = false;           // Ready::recallAgain said, no Recalled yet
   long askedAt_ = -1;                // the newest kept step that made it ask
+  long historiesAskedAt_ = -1;       // askedAt_ when it last asked for the neighbours' histories
+  std::vector<int> historiesOf_;     // the neighbours whose histories it asked for
+  bool fetchingHistories_ = false;   // Ready::askNeighbourHistories said, no NeighbourHistories yet
+  std::vector<StateArrived> backfill_;  // neighbours' states from their holders, by step, until usable
+  bool releasing_ = false;           // advance() is offering kept states
 };
 
 }  // namespace vf::protocol
