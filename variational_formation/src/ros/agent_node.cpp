@@ -21,6 +21,7 @@ namespace vf {
 
 namespace {
 constexpr double kReportEvery = 5.0;  // seconds between "waiting for ..." lines
+constexpr double kMonitorWait = 2.0;  // seconds a resumed agent in a manager waits for the monitor to connect
 
 }  // namespace
 
@@ -79,6 +80,7 @@ void AgentNode::advertiseState(ros::NodeHandle& nh) {
       [this, alive](const ros::SingleSubscriberPublisher& s) {
         if (!*alive) return;
         if (const AgentState::ConstPtr newest = audience_->connected(s.getSubscriberName())) s.publish(*newest);
+        if (s.getSubscriberName() == monitor_) monitorConnected();  // a monitor that reads the agents' topics
       },
       ros::SubscriberStatusCallback(), ros::VoidConstPtr(), nullptr);
   options.latch = true;  // once live (TopicAudience): the latch hands a new subscriber the newest
@@ -159,6 +161,11 @@ void AgentNode::onProgress(const ros::MessageEvent<RunProgress const>& event) {
     drop("a progress message from " + event.getPublisherName() + ", which is not the monitor " + monitor_);
     return;
   }
+  if (awaitMonitor_) {  // resumed: the progress waits until the monitor is connected
+    heldProgress_ = event;
+    progressHeld_ = true;
+    return;
+  }
   const RunProgress& p = *event.getConstMessage();
   carryOut(protocol_->step(Protocol::ProgressArrived{agentProgressOf(p), p}));
 }
@@ -193,6 +200,11 @@ void AgentNode::publish(const AgentState::ConstPtr& state) {
 }
 
 void AgentNode::reportWaiting() {
+  if (awaitMonitor_ && secondsSince(awaitSince_) >= kMonitorWait) {
+    ROS_WARN("%s: resumed at step %ld, and the monitor %s has not connected to this manager's states within "
+             "%.0f s; going on without it", name_.c_str(), agent().step(), monitor_.c_str(), kMonitorWait);
+    monitorConnected();
+  }
   if (protocol_->exitStatus() >= 0) return;
   // Seen to move since the last look (every kReportEvery / 2): it is not waiting.
   if (agent().step() != stepSeen_) {
@@ -247,6 +259,18 @@ void AgentNode::readInbox() {
 
 void AgentNode::start(const Recovery& recovery) {
   resume(recovery);
+  StateBatch* batch = StateBatch::local();
+  if (agent().step() > 0 && batch && batch->ids().count(agent().id()) > 0) {
+    // Before the progress can arrive: start() runs on the agent's queue, as every callback below.
+    awaitMonitor_ = true;
+    awaitSince_ = ros::WallTime::now();
+    const std::shared_ptr<bool> alive = alive_;
+    if (batch->connectedOrLater(monitor_, nh_.getCallbackQueue(), [this, alive] {
+          if (*alive) monitorConnected();
+        })) {
+      awaitMonitor_ = false;
+    }
+  }
   subscribeToFormation(
       nh_, sources(), 1000,
       [this](int j, const ros::MessageEvent<AgentState const>& e) { onNeighbourState(j, e); },

@@ -10,6 +10,7 @@
 #include <ros/callback_queue_interface.h>
 
 #include "variational_formation/ros/pacer.hpp"
+#include "variational_formation/ros/liveness.hpp"
 #include "variational_formation/ros/participant_names.hpp"
 #include "variational_formation/ros/recalled.hpp"
 #include "variational_formation/ros/service_call.hpp"
@@ -98,6 +99,17 @@ void AgentNode::askNeighbourHistories(const std::vector<int>& ids) {
       carryOut(protocol_->step(*histories));
     }), reinterpret_cast<uint64_t>(this));
   }).detach();
+}
+
+void AgentNode::monitorConnected() {
+  if (!awaitMonitor_) return;
+  awaitMonitor_ = false;
+  if (progressHeld_) {
+    ROS_INFO("%s: resumed; the monitor took %.3f s to connect to this manager's states, and the agent waited for it",
+             name_.c_str(), secondsSince(awaitSince_));
+    progressHeld_ = false;
+    onProgress(heldProgress_);
+  }
 }
 
 bool AgentNode::onRecall(RecallState::Request& request, RecallState::Response& response) {

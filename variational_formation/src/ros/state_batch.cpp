@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "variational_formation_core/common/invalid_input.hpp"
+#include "variational_formation/ros/pacer.hpp"
 
 namespace vf {
 
@@ -32,7 +33,7 @@ StateBatch::StateBatch(ros::NodeHandle& pnh, const std::vector<int>& ids)
   const uint32_t depth = static_cast<uint32_t>(std::max<std::size_t>(1000, 250 * ids_.size()));
   ros::AdvertiseOptions options = ros::AdvertiseOptions::create<variational_formation_msgs::AgentStates>(
       "states", depth, [this](const ros::SingleSubscriberPublisher& s) { onConnect(s); },
-      ros::SubscriberStatusCallback(), ros::VoidConstPtr(), nullptr);
+      [this](const ros::SingleSubscriberPublisher& s) { onDisconnect(s); }, ros::VoidConstPtr(), nullptr);
   pub_ = pnh.advertise(options);
   pending_->states.reserve(ids_.size());
   const std::size_t size = ids_.empty() ? 0 : static_cast<std::size_t>(*ids_.rbegin()) + 1;
@@ -118,13 +119,39 @@ void StateBatch::publish(const variational_formation_msgs::AgentStatesPtr& batch
 
 void StateBatch::onConnect(const ros::SingleSubscriberPublisher& subscriber) {
   variational_formation_msgs::AgentStates newest;
+  std::vector<Waiter> ready;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     for (const auto& held : newest_) {
       if (held) newest.states.push_back(*held);
     }
+    const std::string name = subscriber.getSubscriberName();
+    subscribers_.insert(name);
+    for (auto it = waiters_.begin(); it != waiters_.end();) {
+      if (it->node == name) {
+        ready.push_back(std::move(*it));
+        it = waiters_.erase(it);
+      } else {
+        ++it;
+      }
+    }
   }
   if (!newest.states.empty()) subscriber.publish(newest);
+  for (Waiter& w : ready) w.queue->addCallback(boost::make_shared<QueuedCall>(std::move(w.call)));
+}
+
+void StateBatch::onDisconnect(const ros::SingleSubscriberPublisher& subscriber) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = subscribers_.find(subscriber.getSubscriberName());
+  if (it != subscribers_.end()) subscribers_.erase(it);
+}
+
+bool StateBatch::connectedOrLater(const std::string& node, ros::CallbackQueueInterface* queue,
+                                  std::function<void()> call) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (subscribers_.count(node) > 0) return true;
+  waiters_.push_back({node, queue, std::move(call)});
+  return false;
 }
 
 namespace {

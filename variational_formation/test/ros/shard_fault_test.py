@@ -1,8 +1,9 @@
 #!/usr/bin/python3
-"""rostest (shard_fault.test): SIGKILL to one of two agent_managers of a formation, ~kills times
-in one unpaced, recorded run, each kill once the run has recovered from the last (the monitor
-completed a step more than a window past the one it had at the kill, which needs the victim's
-new process). The victim's respawned process reloads its agents, which recover from their
+"""rostest (shard_fault.test): SIGKILLs to one of two agent_managers of a formation, in one
+unpaced, recorded run: ~pairs pairs of kills, the second 0.2 to 0.8 s after the respawned process
+registered (while its agents recover or have just resumed), each pair once the run has recovered
+from the last (the monitor completed a step more than a window past the one it had at the kill,
+which needs the victim's new process). The victim's respawned process reloads its agents, which recover from their
 holders; where a kill took steps that existed nowhere else, they compute them again from their
 neighbours' states in the other manager ("to compute the lost steps again" on /rosout, counted
 and printed). The run must end by itself as succeeded, with every (agent, step) state recorded
@@ -29,18 +30,20 @@ from fault_test import NS, WINDOW, FaultRun  # noqa: E402
 
 VICTIM = f"{NS}/manager_a"
 RECOMPUTED = "to compute the lost steps again"
+WAITED = "the agent waited for it"  # a resumed agent that waited for the monitor to connect
+RESUMED = "; resuming"  # "agent_i: recovered step k from ...; resuming"
 
 
 class StatusWatch:
     """The newest completed step (the monitor's status), and the agents' log lines that say they
-    compute lost steps again."""
+    compute lost steps again or waited for the monitor."""
 
     def __init__(self):
         self.lock = threading.Lock()
         self.step = -1
-        self.recomputed = []
+        self.recomputed, self.waited, self.resumed = [], [], []
         self.subs = [rospy.Subscriber(f"{NS}/status", FormationStatus, self.on_status, queue_size=10000),
-                     rospy.Subscriber("/rosout_agg", Log, self.on_log, queue_size=10000)]
+                     rospy.Subscriber("/rosout", Log, self.on_log, queue_size=10000)]
 
     def on_status(self, msg):
         with self.lock:
@@ -50,6 +53,12 @@ class StatusWatch:
         if RECOMPUTED in msg.msg:
             with self.lock:
                 self.recomputed.append(msg.msg)
+        elif WAITED in msg.msg:
+            with self.lock:
+                self.waited.append(msg.msg)
+        elif RESUMED in msg.msg:
+            with self.lock:
+                self.resumed.append(msg.msg)
 
     def wait_for_step(self, step, timeout=60.0):
         end = time.time() + timeout
@@ -65,7 +74,7 @@ class ShardFault(FaultRun):
         rospy.init_node("shard_fault_test")
         cls.fault = "kill_manager"
         cls.seed = int(rospy.get_param("~seed", 1))
-        kills = int(rospy.get_param("~kills", 4))
+        pairs = int(rospy.get_param("~pairs", 2))
         cls.out = rospy.get_param("~output_dir")
         cls.path = rospy.get_param("~scenario")
         cls.scenario = vf_rostest.load_scenario(cls.path)
@@ -73,17 +82,25 @@ class ShardFault(FaultRun):
         steps = int(cls.scenario["steps"])
         cls.watch = StatusWatch()
         cls.recoveries, cls.injected = [], []
-        # Spread over the run's first two thirds: each kill then still finds the run going.
-        at = sorted(random.Random(cls.seed).sample(range(steps // 20, 2 * steps // 3), kills))
+        rng = random.Random(cls.seed)
+        # Spread over the run's first two thirds: each pair then still finds the run going.
+        at = sorted(rng.sample(range(steps // 20, 2 * steps // 3), pairs))
         for step in at:
             step = max(step, cls.watch.step + 1)
             assert cls.watch.wait_for_step(step), f"the run never reached step {step} (at {cls.watch.step})"
+            first = cls.kill(step)
+            # The second kill of a pair: soon after the respawned process registered, while its
+            # agents recover or have just resumed.
             pid = vf_rostest.node_pid(VICTIM)
-            killed_at = time.monotonic()
-            os.kill(pid, signal.SIGKILL)
+            end = time.monotonic() + 30.0
+            while pid == first and time.monotonic() < end:
+                time.sleep(0.01)
+                pid = vf_rostest.node_pid(VICTIM)
+            assert pid != first, f"{VICTIM} was not respawned within 30 s"
+            time.sleep(rng.uniform(0.2, 0.8))
             completed = cls.watch.step
-            rospy.loginfo("shard_fault_test: seed %d: SIGKILL to %s (pid %d) at step %d", cls.seed, VICTIM, pid, completed)
-            cls.injected.append((completed, [VICTIM]))
+            killed_at = time.monotonic()
+            cls.kill(completed)
             # The agents ran at most a window ahead of the completed step: past that, the
             # victim's new process has computed steps of its own.
             assert cls.watch.wait_for_step(completed + WINDOW + 2, 90.0), (
@@ -92,9 +109,19 @@ class ShardFault(FaultRun):
         cls.result = vf_rostest.wait_for_result(os.path.join(cls.out, cls.name + ".result.yaml"), 120.0)
         cls.expected = vf_rostest.simulate(cls.path)
         with cls.watch.lock:
-            print(f"shard_fault_test: {len(at)} kills at steps {[k for k, _ in cls.injected]}; lost steps computed "
-                  f"again {len(cls.watch.recomputed)} times", flush=True)
+            print(f"shard_fault_test: {len(cls.injected)} kills at steps {[k for k, _ in cls.injected]}; agents resumed "
+                  f"{len(cls.watch.resumed)} times; lost steps "
+                  f"computed again {len(cls.watch.recomputed)} times; a resumed agent waited for the monitor to connect "
+                  f"{len(cls.watch.waited)} times", flush=True)
 
+    @classmethod
+    def kill(cls, step):
+        """SIGKILL to the victim's process; returns its pid."""
+        pid = vf_rostest.node_pid(VICTIM)
+        os.kill(pid, signal.SIGKILL)
+        rospy.loginfo("shard_fault_test: seed %d: SIGKILL to %s (pid %d) at step %d", cls.seed, VICTIM, pid, step)
+        cls.injected.append((step, [VICTIM]))
+        return pid
 
 if __name__ == "__main__":
     rostest.rosrun(vf_rostest.PKG, "shard_fault_test", ShardFault, sys.argv)

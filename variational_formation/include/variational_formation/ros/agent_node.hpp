@@ -112,6 +112,9 @@ class AgentNode {
   /// Protocol's Ready::recallAgain: askHolders() from a thread of its own, the answer then
   /// given to the protocol on this agent's queue (src/ros/agent_recovery.cpp).
   void recallAgain();
+  /// Ends the wait for the monitor after a resume in an agent_manager: the progress held meanwhile
+  /// goes to the protocol (src/ros/agent_recovery.cpp).
+  void monitorConnected();
   /// Protocol's Ready::askNeighbourHistories: `~history` of each neighbour j in `ids` from j and
   /// j's neighbours, from a thread of its own; their states of j then go to the protocol on this
   /// agent's queue (src/ros/agent_recovery.cpp).
@@ -163,6 +166,14 @@ class AgentNode {
   // The waiting line (not a roscpp timer: one per agent of a manager is costly). Last, so that it
   // stops, and a call in progress ends, before any member it reads goes.
   PeriodicCall watch_;
+  // Resumed in an agent_manager: no step until the monitor is connected to where this agent's
+  // states go (the manager's batch, or its own topic), or kMonitorWait has passed. A state
+  // published before that would reach no holder outside the process, and a second kill would
+  // lose it for good (doc/distributed.md, "Crash recovery").
+  bool awaitMonitor_ = false;
+  ros::WallTime awaitSince_;
+  bool progressHeld_ = false;
+  ros::MessageEvent<RunProgress const> heldProgress_;  // the newest progress while it waits
 };
 
 }  // namespace vf

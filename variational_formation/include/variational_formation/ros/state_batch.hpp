@@ -43,6 +43,12 @@ class StateBatch {
   void add(const variational_formation_msgs::AgentState::ConstPtr& state);
   /// ~agents: the agents this manager batches.
   const std::set<int>& ids() const { return ids_; }
+  /**
+   * Whether subscriber `node` (a full node name) is connected to the batches now. If it is not,
+   * `call` goes onto `queue` once it connects (once). Every batch published after that reaches
+   * it: a resumed agent waits for the monitor this way (doc/distributed.md, "Crash recovery").
+   */
+  bool connectedOrLater(const std::string& node, ros::CallbackQueueInterface* queue, std::function<void()> call);
 
  private:
   StateBatch(ros::NodeHandle& pnh, const std::vector<int>& ids);
@@ -58,6 +64,7 @@ class StateBatch {
   /// A subscriber that connects gets each agent's newest state at once, as the latched
   /// agent_<i>/state topics give it (a monitor or recorder started late misses nothing).
   void onConnect(const ros::SingleSubscriberPublisher& subscriber);
+  void onDisconnect(const ros::SingleSubscriberPublisher& subscriber);
 
   std::set<int> ids_;
   std::mutex mutex_;
@@ -66,6 +73,13 @@ class StateBatch {
   std::deque<variational_formation_msgs::AgentStatesPtr> spent_;  // published, oldest first
   std::vector<char> batched_;  // by agent id: in ids_ (a look-up per state, not a tree search)
   std::vector<variational_formation_msgs::AgentState::ConstPtr> newest_;  // by agent id; guarded by mutex_
+  std::multiset<std::string> subscribers_;  // connected subscribers' node names; guarded by mutex_
+  struct Waiter {
+    std::string node;
+    ros::CallbackQueueInterface* queue;
+    std::function<void()> call;
+  };
+  std::vector<Waiter> waiters_;  // connectedOrLater's; guarded by mutex_
   ros::Publisher pub_;
   bool stopping_ = false;  // guarded by mutex_
   std::condition_variable stop_;
