@@ -1,13 +1,15 @@
 #!/usr/bin/python3
 """rostest (shard_fault.test): SIGKILLs to one of two agent_managers of a formation, in one
 unpaced, recorded run: ~pairs pairs of kills, the second 0.2 to 0.8 s after the respawned process
-registered (while its agents recover or have just resumed), each pair once the run has recovered
-from the last (the monitor completed a step more than a window past the one it had at the kill,
-which needs the victim's new process). The victim's respawned process reloads its agents, which recover from their
-holders; where a kill took steps that existed nowhere else, they compute them again from their
-neighbours' states in the other manager ("to compute the lost steps again" on /rosout, counted
-and printed). The run must end by itself as succeeded, with every (agent, step) state recorded
-once and equal to simulate bit for bit (fault_test.FaultRun's checks).
+registered (while its agents recover or have just resumed). Each pair waits until the run has
+recovered, that is until the monitor completed a step more than a window past the one it had at
+the last kill, which needs the victim's new process. The respawned process reloads its agents,
+which recover from their holders: where a kill took steps that existed nowhere else, they compute
+them again from their neighbours' states in the other manager; where the monitor had not yet
+connected to the new process, they wait for it. The run must end by itself as succeeded, with
+every (agent, step) state recorded once and equal to simulate bit for bit (fault_test.FaultRun's
+checks). It prints how often the agents resumed, computed lost steps again and waited (their
+lines on /rosout).
 
 It watches the monitor's status only: subscribing to an agent's own topic would make that agent
 publish on it, which the agents of a manager otherwise leave to the manager's batch.
