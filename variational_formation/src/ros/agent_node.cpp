@@ -37,8 +37,9 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   managers_ = agentManagers(nh, pnh);
   const std::shared_ptr<SensingBoard> board = SensingHub::board(nh, scenario, managers_);
   sharedBoard_ = board != nullptr;
+  formation_ = sharedFormation(shared);
   protocol_ = std::make_unique<Protocol>(
-      LockstepAgent(shared, sharedFormation(shared), id, StartMethod::Variational, board),
+      LockstepAgent(shared, formation_, id, StartMethod::Variational, board),
       [this](const LockstepAgent& a, const std::string& failure) { return makeState(a, failure); }, realTimeFactor_,
       [] { return ros::WallTime::now().toSec(); }, Pacer::kGrain);
   name_ = "agent_" + std::to_string(id);

@@ -61,12 +61,10 @@ void AgentNode::askNeighbourHistories(const std::vector<int>& ids) {
   std::vector<std::string> services;
   std::vector<RecallHistory> calls;
   std::vector<int> whose;
-  const Scenario& scenario = agent().scenario();
   for (int j : ids) {
     std::vector<int> holders{j};
-    for (const auto& e : scenario.edges) {
-      const int k = e.first == j ? e.second : e.second == j ? e.first : -1;
-      if (k >= 0 && k != agent().id()) holders.push_back(k);
+    for (const Neighbour& k : formation_->neighbours(j)) {
+      if (k.agent != agent().id()) holders.push_back(k.agent);
     }
     for (int k : holders) {
       services.push_back(agentNodeName(nh_, k) + "/history");

@@ -124,6 +124,7 @@ class AgentNode {
   const LockstepAgent& agent() const { return protocol_->agent(); }
 
   ros::NodeHandle nh_;
+  std::shared_ptr<const Formation> formation_;  // the process's one (sharedFormation): who neighbours whom
   std::unique_ptr<Protocol> protocol_;
   // Its own state messages (makeState): the oldest, once nothing else holds it (its step is out
   // of every history, queue and latch), is filled again for the next state. Held longer than 128

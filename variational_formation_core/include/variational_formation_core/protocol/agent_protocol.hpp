@@ -316,10 +316,7 @@ class AgentProtocol {
       const long sender = static_cast<long>(msg.id) == e.topic ? e.topic : -1;
       const auto receipt = agent_.receive(sender, msg.step, msg.position, msg.previous_position);
       if (receipt == LockstepAgent::Receipt::Accepted) {
-        const std::vector<int>& ids = agent_.neighbourIds();
-        const auto k = static_cast<std::size_t>(std::find(ids.begin(), ids.end(), e.topic) - ids.begin());
-        if (k < ids.size()) neighbourHistory_[k].push_back(e.state);
-        advance(r);
+        accepted(r, e);
       } else if (receipt == LockstepAgent::Receipt::ImpossibleStep && sender >= 0 && msg.step > agent_.step() + 1 &&
                  !agent_.advancedSinceResume()) {
         keepAhead(r, e);
@@ -398,14 +395,18 @@ class AgentProtocol {
     if (static_cast<long>(msg.id) != e.topic) return;
     try {
       if (agent_.receive(e.topic, msg.step, msg.position, msg.previous_position) == LockstepAgent::Receipt::Accepted) {
-        const std::vector<int>& ids = agent_.neighbourIds();
-        const auto k = static_cast<std::size_t>(std::find(ids.begin(), ids.end(), e.topic) - ids.begin());
-        if (k < ids.size()) neighbourHistory_[k].push_back(e.state);
-        advance(r);
+        accepted(r, e);
       }
     } catch (const std::exception& ex) {
       r.dropped = std::string("a state from a holder's history: ") + ex.what();
     }
+  }
+  /// A state the agent accepted: into its sender's history (a neighbour's), then on.
+  void accepted(Ready& r, const StateArrived& e) {
+    const std::vector<int>& ids = agent_.neighbourIds();
+    const auto k = static_cast<std::size_t>(std::find(ids.begin(), ids.end(), e.topic) - ids.begin());
+    if (k < ids.size()) neighbourHistory_[k].push_back(e.state);
+    advance(r);
   }
   /// "agent_3, agent_5": the senders of the states kept past our step + 1.
   std::string aheadList() const {
