@@ -94,20 +94,29 @@ class Watch:
 @vf_rostest.reported_setup
 class FaultRun(unittest.TestCase, vf_rostest.RunChecks):
     @classmethod
-    def setUpClass(cls):
-        rospy.init_node("fault_test")
-        cls.fault = rospy.get_param("~fault")
+    def open_run(cls, node, fault=None, scenario="hexagon"):
+        """What every fault run's set-up begins with: this test's node, its fault (~fault if None),
+        ~seed, ~output_dir and the scenario (~scenario: a file, or a name under config/, whose
+        default is `scenario`; None: it must be given), and no fault injected yet. Returns the
+        scenario's step count."""
+        rospy.init_node(node)
+        cls.fault = rospy.get_param("~fault") if fault is None else fault
         cls.seed = int(rospy.get_param("~seed", 1))
-        cls.kills = int(rospy.get_param("~kills", 1))
         cls.out = rospy.get_param("~output_dir")
-        cls.path = vf_rostest.scenario_path(rospy.get_param("~scenario", "hexagon"))
+        name = rospy.get_param("~scenario") if scenario is None else rospy.get_param("~scenario", scenario)
+        cls.path = vf_rostest.scenario_path(name)
         cls.scenario = vf_rostest.load_scenario(cls.path)
         cls.name = os.path.basename(cls.path).replace(".yaml", "")
-        n, steps = cls.scenario["n"], int(cls.scenario["steps"])
+        cls.recoveries, cls.injected = [], []
+        return int(cls.scenario["steps"])
+
+    @classmethod
+    def setUpClass(cls):
+        steps = cls.open_run("fault_test")
+        cls.kills = int(rospy.get_param("~kills", 1))
+        n = cls.scenario["n"]
         rng = random.Random(cls.seed)
         cls.watch = Watch(n)
-        cls.recoveries = []
-        cls.injected = []
         if cls.fault in ("kill_agent", "kill_agent_twice", "stop_agent"):
             victim = rng.randrange(n)
             count = 2 if cls.fault == "kill_agent_twice" else cls.kills

@@ -10,7 +10,6 @@ import random
 import signal
 import sys
 import time
-import unittest
 
 import rospy
 import rostest
@@ -24,16 +23,8 @@ from fault_test import NS, FaultRun, Watch  # noqa: E402
 class ManagerFault(FaultRun):
     @classmethod
     def setUpClass(cls):
-        rospy.init_node("fault_test")
-        cls.fault = "kill_manager"
-        cls.seed = int(rospy.get_param("~seed", 1))
-        cls.out = rospy.get_param("~output_dir")
-        cls.path = vf_rostest.scenario_path(rospy.get_param("~scenario", "hexagon"))
-        cls.scenario = vf_rostest.load_scenario(cls.path)
-        cls.name = os.path.basename(cls.path).replace(".yaml", "")
-        steps = int(cls.scenario["steps"])
+        steps = cls.open_run("fault_test", "kill_manager")
         cls.watch = Watch(cls.scenario["n"])
-        cls.recoveries, cls.injected = [], []
         step = random.Random(cls.seed).randrange(steps // 10, steps - 40)
         assert cls.watch.wait_for_step(step), f"the run never reached step {step}"
         pid = vf_rostest.node_pid(f"{NS}/manager")

@@ -73,17 +73,9 @@ class StatusWatch:
 class ShardFault(FaultRun):
     @classmethod
     def setUpClass(cls):
-        rospy.init_node("shard_fault_test")
-        cls.fault = "kill_manager"
-        cls.seed = int(rospy.get_param("~seed", 1))
+        steps = cls.open_run("shard_fault_test", "kill_manager", scenario=None)
         pairs = int(rospy.get_param("~pairs", 2))
-        cls.out = rospy.get_param("~output_dir")
-        cls.path = rospy.get_param("~scenario")
-        cls.scenario = vf_rostest.load_scenario(cls.path)
-        cls.name = os.path.basename(cls.path).replace(".yaml", "")
-        steps = int(cls.scenario["steps"])
         cls.watch = StatusWatch()
-        cls.recoveries, cls.injected = [], []
         rng = random.Random(cls.seed)
         # Spread over the run's first two thirds: each pair then still finds the run going.
         at = sorted(rng.sample(range(steps // 20, 2 * steps // 3), pairs))
