@@ -25,7 +25,6 @@ import signal
 import statistics
 import subprocess
 import sys
-import threading
 import time
 import unittest
 
@@ -33,7 +32,7 @@ import math
 import rosbag
 import rospy
 import rostest
-from variational_formation_msgs.msg import AgentState, FormationStatus
+from variational_formation_msgs.msg import AgentState
 from variational_formation_msgs.srv import RecallHistory
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -48,22 +47,16 @@ WINDOW = 100
 
 
 
-class Watch:
+class Watch(vf_rostest.StepWatcher):
     """Live view of the run: the newest completed step, and each agent's newest step with the
     time it arrived."""
 
     def __init__(self, n):
-        self.lock = threading.Lock()
-        self.step = -1
+        super().__init__(f"{NS}/status")
         self.newest = {i: (-1, 0.0) for i in range(n)}
         self.last = {i: -1 for i in range(n)}  # the step of each agent's last state, older or not
-        self.subs = [rospy.Subscriber(f"{NS}/status", FormationStatus, self.on_status, queue_size=10000)]
         self.subs += [rospy.Subscriber(f"{NS}/agent_{i}/state", AgentState, self.on_state, i, queue_size=10000)
                       for i in range(n)]
-
-    def on_status(self, msg):
-        with self.lock:
-            self.step = max(self.step, msg.step)
 
     def on_state(self, msg, i):
         if msg._connection_header.get("callerid") != f"{NS}/agent_{i}":
@@ -72,12 +65,6 @@ class Watch:
             self.last[i] = msg.step
             if msg.step > self.newest[i][0]:
                 self.newest[i] = (msg.step, time.monotonic())
-
-    def wait_for_step(self, step, timeout=60.0):
-        end = time.time() + timeout
-        while self.step < step and time.time() < end:
-            time.sleep(0.01)
-        return self.step >= step
 
     def wait_for_agent_beyond(self, agent, step, timeout=60.0):
         """Seconds until agent publishes a step > `step` (None on timeout)."""

@@ -42,7 +42,7 @@ import numpy as np  # noqa: E402
 import rospy  # noqa: E402
 import rostest  # noqa: E402
 import yaml  # noqa: E402
-from variational_formation_msgs.msg import AgentState, FormationStatus, RunProgress  # noqa: E402
+from variational_formation_msgs.msg import AgentState, RunProgress  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import vf_rostest  # noqa: E402
@@ -59,25 +59,6 @@ def run_formation(*args, timeout=120):
 def start(cmd):
     return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                             start_new_session=True)
-
-
-
-
-class StepWatcher:
-    """The newest step seen on the status topic."""
-
-    def __init__(self):
-        self.step = -1
-        self.sub = rospy.Subscriber("/formation/status", FormationStatus, self.on_status, queue_size=1000)
-
-    def on_status(self, msg):
-        self.step = max(self.step, msg.step)
-
-    def wait_for(self, step, timeout=30.0):
-        end = time.time() + timeout
-        while self.step < step and time.time() < end:
-            time.sleep(0.02)
-        return self.step >= step
 
 
 @vf_rostest.reported_setup
@@ -172,17 +153,17 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
 
     def check_killed_agent_fails_the_run(self, kill, victim):
         out = os.path.join(self.tmp, "killed")
-        watcher = StepWatcher()
+        watcher = vf_rostest.StepWatcher(queue_size=1000, poll=0.02)
         run = start(["rosrun", PKG, "run_formation.sh", f"scenario:={SCENARIO}", "rate:=1", "respawn:=false",
                      f"output_dir:={out}"])
         try:
-            self.assertTrue(watcher.wait_for(60), "the run did not start")
+            self.assertTrue(watcher.wait_for_step(60, 30.0), "the run did not start")
             kill(victim)
             killed_at = time.time()
             log, _ = run.communicate(timeout=40)
             ended_after = time.time() - killed_at
         finally:
-            watcher.sub.unregister()
+            watcher.unregister()
             if run.poll() is None:
                 os.killpg(run.pid, signal.SIGINT)
                 run.wait(timeout=30)
@@ -290,12 +271,12 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
         subs = [rospy.Subscriber(f"/formation/agent_{i}/state", AgentState, on_state, i, queue_size=100000)
                 for i in range(self.scenario["n"])]
         subs.append(rospy.Subscriber("/formation/progress", RunProgress, on_progress, queue_size=1000))
-        watcher = StepWatcher()
+        watcher = vf_rostest.StepWatcher(queue_size=1000, poll=0.02)
         out = os.path.join(self.tmp, "window")
         run = start(["rosrun", PKG, "run_formation.sh", f"scenario:={unbounded}", f"window:={window}",
                      f"output_dir:={out}"])
         try:
-            self.assertTrue(watcher.wait_for(300), "the run did not start")
+            self.assertTrue(watcher.wait_for_step(300, 30.0), "the run did not start")
             # This test's own subscriptions must have heard the monitor and every agent before
             # the monitor stops: a stopped node cannot answer a new subscriber's connection.
             end = time.time() + 60
@@ -314,11 +295,11 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
             self.assertLessEqual(max(s for s, _ in steps.values()), allowed[0])
             self.assertLessEqual(allowed[0], stopped_at + window)
             os.kill(monitor, signal.SIGCONT)
-            self.assertTrue(watcher.wait_for(stopped_at + 500), "the run did not go on after SIGCONT")
+            self.assertTrue(watcher.wait_for_step(stopped_at + 500, 30.0), "the run did not go on after SIGCONT")
         finally:
             for s in subs:
                 s.unregister()
-            watcher.sub.unregister()
+            watcher.unregister()
             os.killpg(run.pid, signal.SIGINT)
             log, _ = run.communicate(timeout=40)
         self.assertEqual(run.returncode, 0, log[-3000:])  # an unbounded run stopped by the user
@@ -353,7 +334,7 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
     def test_recording_splits_and_stops_at_its_size_limit(self):
         unbounded = self.scenario_variant("unbounded_recorded", steps=0)
         out = os.path.join(self.tmp, "limited")
-        watcher = StepWatcher()
+        watcher = vf_rostest.StepWatcher(queue_size=1000, poll=0.02)
         run = start(["rosrun", PKG, "run_formation.sh", f"scenario:={unbounded}", "record:=true",
                      "record_max_size:=2", "record_split_size:=0.5", f"output_dir:={out}"])
         parts = lambda: sorted(f for f in os.listdir(out) if f.endswith(".bag") or f.endswith(".bag.active"))  # noqa: E731
@@ -368,7 +349,7 @@ class LaunchTest(unittest.TestCase, vf_rostest.RunChecks):
                              "the recording went on past its limit")
             self.assertGreater(watcher.step, step_then, "the run stopped with the recording")
         finally:
-            watcher.sub.unregister()
+            watcher.unregister()
             os.killpg(run.pid, signal.SIGINT)
             log, _ = run.communicate(timeout=40)
         self.assertEqual(run.returncode, 0, log[-3000:])

@@ -18,13 +18,11 @@ import os
 import random
 import signal
 import sys
-import threading
 import time
 
 import rospy
 import rostest
 from rosgraph_msgs.msg import Log
-from variational_formation_msgs.msg import FormationStatus
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import vf_rostest  # noqa: E402
@@ -36,20 +34,14 @@ WAITED = "the agent waited for it"  # a resumed agent that waited for the monito
 RESUMED = "; resuming"  # "agent_i: recovered step k from ...; resuming"
 
 
-class StatusWatch:
+class StatusWatch(vf_rostest.StepWatcher):
     """The newest completed step (the monitor's status), and the agents' log lines that say they
     compute lost steps again or waited for the monitor."""
 
     def __init__(self):
-        self.lock = threading.Lock()
-        self.step = -1
+        super().__init__(f"{NS}/status", poll=0.002)
         self.recomputed, self.waited, self.resumed = [], [], []
-        self.subs = [rospy.Subscriber(f"{NS}/status", FormationStatus, self.on_status, queue_size=10000),
-                     rospy.Subscriber("/rosout", Log, self.on_log, queue_size=10000)]
-
-    def on_status(self, msg):
-        with self.lock:
-            self.step = max(self.step, msg.step)
+        self.subs.append(rospy.Subscriber("/rosout", Log, self.on_log, queue_size=10000))
 
     def on_log(self, msg):
         if RECOMPUTED in msg.msg:
@@ -61,12 +53,6 @@ class StatusWatch:
         elif RESUMED in msg.msg:
             with self.lock:
                 self.resumed.append(msg.msg)
-
-    def wait_for_step(self, step, timeout=60.0):
-        end = time.time() + timeout
-        while self.step < step and time.time() < end:
-            time.sleep(0.002)
-        return self.step >= step
 
 
 @vf_rostest.reported_setup

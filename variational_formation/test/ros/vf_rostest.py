@@ -6,6 +6,7 @@ import math
 import os
 import subprocess
 import tempfile
+import threading
 import time
 import traceback
 
@@ -250,6 +251,33 @@ class RunChecks:
                 scale = max(1.0, math.sqrt(pred.x ** 2 + pred.y ** 2 + pred.z ** 2))
                 err = math.sqrt((x.x - pred.x) ** 2 + (x.y - pred.y) ** 2 + (x.z - pred.z) ** 2)
                 self.assertLess(err / scale, 1e-9, f"step {k}")
+
+
+class StepWatcher:
+    """The newest completed step on the monitor's status topic, and a wait for a given one. Fault
+    tests extend it with what else they follow (each agent's states, log lines)."""
+
+    def __init__(self, topic="/formation/status", queue_size=10000, poll=0.01):
+        from variational_formation_msgs.msg import FormationStatus
+        self.lock = threading.Lock()
+        self.step = -1
+        self.poll = poll  # s between two looks while waiting
+        self.subs = [rospy.Subscriber(topic, FormationStatus, self.on_status, queue_size=queue_size)]
+
+    def on_status(self, msg):
+        with self.lock:
+            self.step = max(self.step, msg.step)
+
+    def wait_for_step(self, step, timeout=60.0):
+        """Whether the status reaches `step` within `timeout` s."""
+        end = time.time() + timeout
+        while self.step < step and time.time() < end:
+            time.sleep(self.poll)
+        return self.step >= step
+
+    def unregister(self):
+        for sub in self.subs:
+            sub.unregister()
 
 
 class Steering:
