@@ -333,6 +333,16 @@ TEST(GoalSteering, RefusesAGoalItCannotReachBeforeTheRunEnds) {
     EXPECT_EQ(std::string(e.what()).rfind("goal.target_pose.pose.position: (1e+300, 1e+300) is too far out: doubles "
                                           "there are ", 0), 0u) << e.what();
   }
+  // Without damping nothing tracks a commanded motion (doc/manoeuvres.md): no goal at all.
+  GoalSteering undamped(GoalSettings(), 0.01, 0.0);
+  goal.position << 1.0, 0.0;
+  try {
+    undamped.checkReachable(goal, at(0, 0, 0), 44.0, field);
+    ADD_FAILURE() << "accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_STREQ(e.what(), "goal.target_pose.pose.position: no goal can be reached with kappa = 0: the damping is "
+                           "what tracks a commanded motion");
+  }
 }
 
 // The closed loop, as the lockstep monitor runs it: each completed step k measured; the allowed

@@ -68,6 +68,10 @@ GoalSteering::GoalSteering(const GoalSettings& settings, double timeStep, double
 
 void GoalSteering::checkReachable(const GoalPose& goal, const FormationPose& from, double secondsLeft,
                                   const std::string& field) const {
+  if (!(dampingGain_ > 0.0)) {
+    throw InvalidInput(field + ": no goal can be reached with kappa = " + number(dampingGain_) +
+                       ": the damping is what tracks a commanded motion");
+  }
   const std::string where = "(" + number(goal.position.x()) + ", " + number(goal.position.y()) + ")";
   const double distance = std::hypot(goal.position.x() - from.position.x(), goal.position.y() - from.position.y());
   const double needs = distance / settings_.maxSpeed;

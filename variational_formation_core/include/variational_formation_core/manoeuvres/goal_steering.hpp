@@ -110,8 +110,8 @@ class GoalSteering {
 
   /**
    * Refuses a goal that cannot be reached: farther from `from` than maxSpeed covers in
-   * `secondsLeft` (the run's time left; infinity for an unbounded run), or so far out that a
-   * double cannot resolve the position tolerance there.
+   * `secondsLeft` (the run's time left; infinity for an unbounded run), so far out that a double
+   * cannot resolve the position tolerance there, or any goal without damping (kappa = 0).
    * @throws InvalidInput naming `field` (e.g. "goal.target_pose.pose.position"), the value and why.
    */
   void checkReachable(const GoalPose& goal, const FormationPose& from, double secondsLeft,
