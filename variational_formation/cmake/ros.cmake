@@ -100,6 +100,8 @@ if(CATKIN_ENABLE_TESTING)
   add_rostest(test/ros/manoeuvre_run.test ARGS case:=faults seed:=5 faults:=true)
   # Goals (move_to, /move_base_simple/goal) in a recorded lockstep run (test/ros/goal.test).
   add_rostest(test/ros/goal.test)
+  # A goal at h = 0.02 with the default window, and one the run cannot reach (goal_window.test).
+  add_rostest(test/ros/goal_window.test)
   # The monitor's markers and trails (no master).
   catkin_add_gtest(test_markers test/ros/test_markers.cpp)
   target_link_libraries(test_markers variational_formation_ros gtest_main)

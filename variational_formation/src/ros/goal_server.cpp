@@ -1,6 +1,8 @@
 #include "variational_formation/ros/goal_server.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "variational_formation_core/common/invalid_input.hpp"
 #include "variational_formation/ros/parameters.hpp"
@@ -29,13 +31,16 @@ std::string withoutSlash(const std::string& frame) { return !frame.empty() && fr
 GoalServer::GoalServer(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Scenario& scenario,
                        const std::string& worldFrame, Offer offer)
     : desired_(scenario.desiredPositions),
+      steps_(scenario.steps),
+      timeStep_(scenario.timeStep),
       worldFrame_(worldFrame),
       offer_(std::move(offer)),
-      steering_(goalSettings(pnh), scenario.timeStep),
+      steering_(goalSettings(pnh), scenario.timeStep, scenario.dampingGain),
       feedbackEvery_(std::max(1L, std::lround(0.1 / scenario.timeStep))) {
   server_ = std::make_unique<Server>(nh, "move_to", false);
   server_->registerGoalCallback([this] { onGoal(); });
   server_->registerPreemptCallback([this] { onPreempt(); });
+  now_.position = scenario.initialPositions.topRows<2>().rowwise().mean();
   server_->start();
   // rviz's 2D Nav Goal: remapped to /move_base_simple/goal by formation.launch.
   relay_ = nh.advertise<move_base_msgs::MoveBaseActionGoal>("move_to/goal", 10);
@@ -66,6 +71,9 @@ void GoalServer::onGoal() {
     }
     const GoalPose pose = goalPose(t.pose.position.x, t.pose.position.y, t.pose.orientation.x, t.pose.orientation.y,
                                    t.pose.orientation.z, t.pose.orientation.w, "goal.target_pose.pose");
+    const double left = steps_ > 0 ? static_cast<double>(steps_ - std::max(lastStep_, 0L)) * timeStep_
+                                   : std::numeric_limits<double>::infinity();
+    steering_.checkReachable(pose, now_, left, "goal.target_pose.pose.position");
     steering_.start(pose, lastStep_ + 1);
     ROS_INFO("monitor: goal (%g, %g) m, yaw %g rad: steering the centroid there", pose.position.x(),
              pose.position.y(), pose.yaw);
@@ -88,11 +96,14 @@ void GoalServer::stopFormation() {
   if (!offer_(Vector3::Zero(), Vector3::Zero(), why)) ROS_WARN("monitor: the stop was refused: %s", why.c_str());
 }
 
-void GoalServer::onStep(long step, const Positions& q, bool inShape, double maxEdgeError, const ros::Time& stamp) {
-  lastStep_ = step;
+void GoalServer::onStep(GoalObservation seen, const Positions& q, const CommandSchedule& inForce,
+                        const ros::Time& stamp) {
+  const long step = lastStep_ = seen.step;
+  now_.position = q.topRows<2>().rowwise().mean();
   if (!steering_.active() || !server_->isActive()) return;
-  const FormationPose pose = formationPose(q, desired_);
-  const SteeringStep s = steering_.update(step, pose, inShape, maxEdgeError);
+  seen.pose = formationPose(q, desired_);
+  const FormationPose& pose = seen.pose;
+  const SteeringStep s = steering_.update(seen, inForce);
   if (s.command) {
     std::string why;
     if (!offer_(s.velocity, s.angularRate, why)) {

@@ -61,6 +61,7 @@ void LockstepMonitor::onRecorderProgress(const ros::MessageEvent<RunProgress con
 }
 
 void LockstepMonitor::carryOut(const Referee::Ready& r) {
+  goalCommandsAt_ = r.commandsAt;  // a goal's command computed from a step below applies there
   for (const FormationSnapshot& s : r.publish) {
     ros::Time stamp;
     stamp.fromSec(s.metrics.time);  // simulated time t_k

@@ -1,6 +1,8 @@
 // Goals for the formation (MonitorNode, monitor_node.hpp; GoalServer): their commands are offered
 // to the monitor's CommandDesk like a cmd_vel, with its checks and limits, and issued as the mode
 // issues any command (lockstep at the allowed step after the status, timed at once).
+#include <algorithm>
+
 #include "variational_formation/ros/monitor_node.hpp"
 
 namespace vf {
@@ -18,6 +20,18 @@ void MonitorNode::setUpGoals(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
         warnCommand("move_to", sender, note);
         return true;
       });
+}
+
+void MonitorNode::steerGoal(const FormationSnapshot& s, bool constrained, const ros::Time& stamp) {
+  GoalObservation seen;
+  seen.step = s.metrics.step;
+  seen.inShape = s.converged;
+  seen.maxEdgeError = s.metrics.maxDistanceError;
+  seen.constrained = constrained;
+  // The desk issues at most one command per allowed step: past the newest issued one only.
+  const long newest = desk_->issued().empty() ? -1 : desk_->issued().back().first;
+  seen.applyStep = goalCommandsAt_ > std::max(newest, seen.step) ? goalCommandsAt_ : -1;
+  goals_->onStep(seen, s.positions, desk_->schedule(), stamp);
 }
 
 }  // namespace vf

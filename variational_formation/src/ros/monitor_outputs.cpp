@@ -41,7 +41,7 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
     status.angular_momentum_predicted.z = nan;
   }
   statusPub_.publish(status);
-  goals_->onStep(s.metrics.step, s.positions, s.converged, s.metrics.maxDistanceError, stamp);
+  steerGoal(s, status.constraints_active > 0, stamp);
   const long step = s.metrics.step, last = scenario_.steps;
   const bool edge = step == 0 || (last > 0 && step == last);
   if (publishClock_) {

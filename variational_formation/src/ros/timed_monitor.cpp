@@ -43,6 +43,7 @@ void TimedMonitor::begin() {
 }
 
 void TimedMonitor::carryOut(const protocol::RefereeReady& r) {
+  goalCommandsAt_ = r.commandsAt;
   for (const FormationSnapshot& s : r.publish) publishSnapshot(s, stampOf(s.metrics.step), referee_->dataAge(), false);
   if (ended()) return;  // a published step was blocked: that Ready ended the run
   if (r.commandsAt >= 0) issueCommands(r.commandsAt);  // a goal's command (GoalServer) goes out at once

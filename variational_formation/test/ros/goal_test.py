@@ -29,21 +29,13 @@ from move_base_msgs.msg import MoveBaseAction, MoveBaseActionResult, MoveBaseGoa
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import vf_rostest  # noqa: E402
-from variational_formation_msgs.msg import AgentState, FormationStatus  # noqa: E402
+from variational_formation_msgs.msg import FormationStatus  # noqa: E402
 
 NS = "/formation"
 
 
-def pose(x, y, yaw, frame="world"):
-    p = PoseStamped()
-    p.header.frame_id = frame
-    p.pose.position.x, p.pose.position.y = x, y
-    p.pose.orientation.z, p.pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
-    return p
-
-
-def wrap(a):
-    return math.atan2(math.sin(a), math.cos(a))
+pose = vf_rostest.goal_pose
+wrap = vf_rostest.wrap
 
 
 @vf_rostest.reported_setup
@@ -54,11 +46,10 @@ class GoalRun(unittest.TestCase, vf_rostest.RunChecks):
         cls.out = rospy.get_param("~output_dir")
         cls.path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "goal_hexagon.yaml")
         cls.scenario = vf_rostest.load_scenario(cls.path)
-        cls.desired = [a["desired_position"] for a in cls.scenario["agents"]]
-        n, steps, h = cls.scenario["n"], int(cls.scenario["steps"]), float(cls.scenario["time_step"])
-        cls.states, cls.step, cls.feedback = {}, -1, []
-        subs = [rospy.Subscriber(f"{NS}/agent_{i}/state", AgentState, cls.on_state, queue_size=200) for i in range(n)]
-        subs.append(rospy.Subscriber(f"{NS}/status", FormationStatus, cls.on_status, queue_size=100))
+        steps, h = int(cls.scenario["steps"]), float(cls.scenario["time_step"])
+        cls.step, cls.feedback = -1, []
+        cls.log = vf_rostest.AgentStates(NS, cls.scenario)
+        subs = [rospy.Subscriber(f"{NS}/status", FormationStatus, cls.on_status, queue_size=100)]
         cls.results = []  # every goal's end, the topic's too: (goal id, status)
         subs.append(rospy.Subscriber(f"{NS}/move_to/result", MoveBaseActionResult,
                                      lambda m: cls.results.append((m.status.goal_id.id, m.status.status)), queue_size=10))
@@ -75,8 +66,9 @@ class GoalRun(unittest.TestCase, vf_rostest.RunChecks):
         cls.state1, cls.text1 = cls.client.get_state(), cls.client.get_goal_status_text()
         cls.pose1 = cls.rest(2.0)
 
-        # 2. A far action goal, pre-empted by rviz's topic.
-        cls.client.send_goal(MoveBaseGoal(target_pose=pose(20.0, 0.0, 0.0)))
+        # 2. A far action goal (6 m, 12 s at 0.5 m/s: one the run could still reach), pre-empted by
+        # rviz's topic.
+        cls.client.send_goal(MoveBaseGoal(target_pose=pose(8.0, 0.0, 0.0)))
         cls.wait_steps(100)
         cls.goal3 = (1.0, -1.0, -0.4)
         cls.topic.publish(pose(*cls.goal3))
@@ -87,7 +79,7 @@ class GoalRun(unittest.TestCase, vf_rostest.RunChecks):
         cls.pose3 = cls.rest(2.0)
 
         # 3. Cancelled on the way.
-        cls.client.send_goal(MoveBaseGoal(target_pose=pose(-10.0, 5.0, 1.0)))
+        cls.client.send_goal(MoveBaseGoal(target_pose=pose(-2.0, 0.0, 1.0)))  # 3.2 m: 6.3 s, within what is left
         cls.wait_steps(150)
         cls.client.cancel_goal()
         cls.wait(lambda: cls.client.get_state() != GoalStatus.ACTIVE, 20, "goal 4 to end")
@@ -109,15 +101,10 @@ class GoalRun(unittest.TestCase, vf_rostest.RunChecks):
             cls.refused.append((cls.client.get_state(), cls.client.get_goal_status_text()))
         for s in subs:
             s.unregister()
+        cls.log.unregister()
 
-        cls.result = vf_rostest.wait_for_result(os.path.join(cls.out, "goal_hexagon.result.yaml"), steps * h / 5 + 90)
-        cls.bag = os.path.join(cls.out, "goal_hexagon.bag")
-        cls.commands_file = os.path.join(cls.out, "goal_hexagon.commands.csv")
-        cls.expected = vf_rostest.simulate(cls.path, cls.commands_file) if os.path.exists(cls.commands_file) else {}
-
-    @classmethod
-    def on_state(cls, msg):
-        cls.states.setdefault(msg.step, {})[msg.id] = list(msg.position)
+        cls.result, cls.bag, cls.commands_file, cls.expected = vf_rostest.recorded_with_commands(
+            cls.out, cls.path, steps * h / 5 + 90)
 
     @classmethod
     def on_status(cls, msg):
@@ -138,17 +125,7 @@ class GoalRun(unittest.TestCase, vf_rostest.RunChecks):
 
     @classmethod
     def pose_now(cls):
-        """(x, y, yaw) of the newest step every agent has reported: the centroid, and the rotation
-        of the best 2D fit of the desired shape onto the positions (Kabsch)."""
-        n = cls.scenario["n"]
-        k = max(step for step, got in list(cls.states.items()) if len(got) == n)
-        q = [cls.states[k][i] for i in range(n)]
-        c = [sum(p[0] for p in q) / n, sum(p[1] for p in q) / n]
-        d = cls.desired
-        dc = [sum(p[0] for p in d) / n, sum(p[1] for p in d) / n]
-        cross = sum((a[0] - dc[0]) * (b[1] - c[1]) - (a[1] - dc[1]) * (b[0] - c[0]) for a, b in zip(d, q))
-        dot = sum((a[0] - dc[0]) * (b[0] - c[0]) + (a[1] - dc[1]) * (b[1] - c[1]) for a, b in zip(d, q))
-        return c[0], c[1], math.atan2(cross, dot)
+        return cls.log.pose_now()
 
     @classmethod
     def near(cls, goal, distance, angle):

@@ -253,6 +253,71 @@ class RunChecks:
                 self.assertLess(err / scale, 1e-9, f"step {k}")
 
 
+def goal_pose(x, y, yaw, frame="world"):
+    """A geometry_msgs/PoseStamped at (x, y) facing `yaw` about z, as rviz's 2D Nav Goal sends."""
+    from geometry_msgs.msg import PoseStamped
+    p = PoseStamped()
+    p.header.frame_id = frame
+    p.pose.position.x, p.pose.position.y = x, y
+    p.pose.orientation.z, p.pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
+    return p
+
+
+def wrap(a):
+    """An angle in (-pi, pi]."""
+    return math.atan2(math.sin(a), math.cos(a))
+
+
+def formation_pose(q, desired):
+    """(x, y, yaw) of positions q: the centroid, and the rotation of the best 2D fit of the desired
+    shape onto q (Kabsch), computed here, not by the package."""
+    n = len(q)
+    c = [sum(p[0] for p in q) / n, sum(p[1] for p in q) / n]
+    dc = [sum(p[0] for p in desired) / n, sum(p[1] for p in desired) / n]
+    cross = sum((a[0] - dc[0]) * (b[1] - c[1]) - (a[1] - dc[1]) * (b[0] - c[0]) for a, b in zip(desired, q))
+    dot = sum((a[0] - dc[0]) * (b[0] - c[0]) + (a[1] - dc[1]) * (b[1] - c[1]) for a, b in zip(desired, q))
+    return c[0], c[1], math.atan2(cross, dot)
+
+
+class AgentStates:
+    """Every agent's position at every step, from their own state topics, and the formation's pose
+    (formation_pose) at the newest step that every agent has reported."""
+
+    def __init__(self, ns, scenario):
+        from variational_formation_msgs.msg import AgentState
+        self.n = scenario["n"]
+        self.desired = [a["desired_position"] for a in scenario["agents"]]
+        self.states = {}
+        self.subs = [rospy.Subscriber(f"{ns}/agent_{i}/state", AgentState, self.on_state, queue_size=500)
+                     for i in range(self.n)]
+
+    def on_state(self, msg):
+        self.states.setdefault(msg.step, {})[msg.id] = list(msg.position)
+
+    def complete(self):
+        """The steps every agent has reported, in order."""
+        return sorted(k for k, got in list(self.states.items()) if len(got) == self.n)
+
+    def pose_now(self):
+        k = self.complete()[-1]
+        return formation_pose([self.states[k][i] for i in range(self.n)], self.desired)
+
+    def unregister(self):
+        for sub in self.subs:
+            sub.unregister()
+
+
+def recorded_with_commands(out, path, timeout):
+    """A recorded run of the scenario at `path` in `out` once over: its result file (waited for up
+    to `timeout` s), its bag, its commands file and `simulate`'s states under that file ({} if
+    there is none)."""
+    name = os.path.splitext(os.path.basename(path))[0]
+    result = wait_for_result(os.path.join(out, name + ".result.yaml"), timeout)
+    commands = os.path.join(out, name + ".commands.csv")
+    expected = simulate(path, commands) if os.path.exists(commands) else {}
+    return result, os.path.join(out, name + ".bag"), commands, expected
+
+
 class StepWatcher:
     """The newest completed step on the monitor's status topic, and a wait for a given one. Fault
     tests extend it with what else they follow (each agent's states, log lines)."""

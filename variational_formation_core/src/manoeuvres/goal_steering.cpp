@@ -58,19 +58,46 @@ void validateGoalSettings(const GoalSettings& s) {
   requireFiniteAbove("~goal_period", s.period, 0.0, "s");
 }
 
-GoalSteering::GoalSteering(const GoalSettings& settings, double timeStep)
+GoalSteering::GoalSteering(const GoalSettings& settings, double timeStep, double dampingGain)
     : settings_(settings),
       timeStep_(timeStep),
+      dampingGain_(dampingGain),
+      lag_(std::exp(-dampingGain * timeStep)),  // doc/maths.md §2: e^{-kappa h}, never e^{kappa t}
       periodSteps_(std::max(1L, std::lround(settings.period / timeStep))),
       patienceSteps_(std::max(1L, std::lround(settings.patience / timeStep))) {}
+
+void GoalSteering::checkReachable(const GoalPose& goal, const FormationPose& from, double secondsLeft,
+                                  const std::string& field) const {
+  if (!(dampingGain_ > 0.0)) {
+    throw InvalidInput(field + ": no goal can be reached with kappa = " + number(dampingGain_) +
+                       ": the damping is what tracks a commanded motion");
+  }
+  const std::string where = "(" + number(goal.position.x()) + ", " + number(goal.position.y()) + ")";
+  const double distance = std::hypot(goal.position.x() - from.position.x(), goal.position.y() - from.position.y());
+  const double needs = distance / settings_.maxSpeed;
+  if (needs > secondsLeft) {
+    throw InvalidInput(field + ": " + where + " is " + number(distance) + " m from the centroid: at ~goal_max_speed " +
+                       number(settings_.maxSpeed) + " m/s that takes at least " + number(needs) +
+                       " s, and the run ends in " + number(secondsLeft) + " s");
+  }
+  const double far = std::max(std::abs(goal.position.x()), std::abs(goal.position.y()));
+  const double spacing = std::nextafter(far, std::numeric_limits<double>::infinity()) - far;
+  if (spacing > 1e-3 * settings_.positionTolerance) {
+    throw InvalidInput(field + ": " + where + " is too far out: doubles there are " + number(spacing) +
+                       " m apart, too coarse for ~goal_tolerance " + number(settings_.positionTolerance) + " m");
+  }
+}
 
 void GoalSteering::start(const GoalPose& goal, long step) {
   goal_ = goal;
   active_ = true;
   startStep_ = progressStep_ = step;
+  constrainedStep_ = -1;
   bestDistance_ = bestYawError_ = std::numeric_limits<double>::infinity();
   previousStep_ = -1;
-  commanded_ = false;  // the first update commands whatever stands
+  applyStep_ = decidedStep_ = -1;
+  latencySteps_ = 0;
+  commanded_ = false;  // the first update that can issue commands whatever stands
 }
 
 bool GoalSteering::stop() {
@@ -89,32 +116,78 @@ SteeringStep GoalSteering::finish(SteeringStep s, SteeringStep::State state) {
   return s;
 }
 
-SteeringStep GoalSteering::update(long step, const FormationPose& pose, bool inShape, double maxEdgeError) {
+FormationPose GoalSteering::predictRest(const GoalObservation& seen, const CommandSchedule& inForce,
+                                        FormationPose& at) const {
+  // The velocity of interval step - 1 (measured), or that of the command in force (none yet).
+  Eigen::Vector2d u = inForce.at(seen.step - 1).velocity.head<2>();
+  double turn = inForce.at(seen.step - 1).angularRate.z();
+  if (previousStep_ >= 0 && seen.step > previousStep_) {
+    const double dt = static_cast<double>(seen.step - previousStep_) * timeStep_;
+    u = (seen.pose.position - previous_.position) / dt;
+    turn = wrapAngle(seen.pose.yaw - previous_.yaw) / dt;
+  }
+  // Each interval's velocity follows the command with the update's damping (doc/maths.md §9.2: the
+  // centroid obeys c'' = -kappa (c' - v*)); the latency is only known commands being followed.
+  at = seen.pose;
+  for (long k = seen.step; k < seen.applyStep; ++k) {
+    const Command& c = inForce.at(k);
+    u = lag_ * u + (1.0 - lag_) * c.velocity.head<2>();
+    turn = lag_ * turn + (1.0 - lag_) * c.angularRate.z();
+    at.position += timeStep_ * u;
+    at.yaw += timeStep_ * turn;
+  }
+  // After the stop: h (a + a^2 + ...) times the last velocity; without damping, no rest.
+  const double coast = lag_ < 1.0 ? timeStep_ * lag_ / (1.0 - lag_) : std::numeric_limits<double>::infinity();
+  FormationPose rest = at;
+  if (u.norm() > 0.0) rest.position += coast * u;
+  if (turn != 0.0) rest.yaw += coast * turn;
+  return rest;
+}
+
+std::string GoalSteering::abortReason(const SteeringStep& s, const GoalObservation& seen) const {
+  const std::string shape =
+      seen.inShape ? std::string() : " (max distance error " + number(seen.maxEdgeError) + " m)";
+  std::string why;
+  if (constrainedStep_ >= progressStep_) {
+    why = "the safety filter binds and the formation does not get closer: blocked" + shape;
+  } else if (seen.inShape) {
+    why = "the formation holds its shape and no safety constraint binds, but it does not follow the commands";
+  } else {
+    why = "the formation is not in its shape" + shape;
+  }
+  return "no progress for " + number(settings_.patience) + " s, " + number(s.distance) + " m and " +
+         number(s.yawError) + " rad from the goal: " + why;
+}
+
+SteeringStep GoalSteering::update(const GoalObservation& seen, const CommandSchedule& inForce) {
   SteeringStep s;
   if (!active_) return s;
   s.state = SteeringStep::State::Active;
-  const Eigen::Vector2d toGoal = goal_.position - pose.position;
+  const long step = seen.step;
+  const Eigen::Vector2d toGoal = goal_.position - seen.pose.position;
   s.distance = toGoal.norm();
-  s.yawError = wrapAngle(goal_.yaw - pose.yaw);
-  // Reached: within both tolerances, and settled there: moving and turning slowly, and told to
-  // (what was commanded may apply only later, up to a lockstep window after it was issued).
-  Eigen::Vector2d rate = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
-  if (previousStep_ >= 0 && step > previousStep_) {
-    const double dt = static_cast<double>(step - previousStep_) * timeStep_;
-    rate << (pose.position - previous_.position).norm() / dt, std::abs(wrapAngle(pose.yaw - previous_.yaw)) / dt;
+  s.yawError = wrapAngle(goal_.yaw - seen.pose.yaw);
+  if (seen.constrained) constrainedStep_ = step;
+  const bool canIssue = seen.applyStep > step;
+  if (canIssue) latencySteps_ = std::max(latencySteps_, seen.applyStep - step);
+  if (canIssue && seen.applyStep > seenApplyStep_) {  // a new apply step: how far from the last one
+    if (seenApplyStep_ >= 0) applyGap_ = seen.applyStep - seenApplyStep_;
+    seenApplyStep_ = seen.applyStep;
   }
-  previous_ = pose;
-  previousStep_ = step;
-  const double slowSpeed = settings_.gain * settings_.positionTolerance;
-  const double slowTurn = settings_.gain * settings_.yawTolerance;
   const bool within = s.distance <= settings_.positionTolerance && std::abs(s.yawError) <= settings_.yawTolerance;
-  if (within && rate(0) <= slowSpeed && rate(1) <= slowTurn && lastVelocity_.norm() <= 2.0 * slowSpeed &&
-      lastAngularRate_.norm() <= 2.0 * slowTurn) {
+  const bool decide = canIssue && seen.applyStep > applyStep_ && (!commanded_ || step - decidedStep_ >= periodSteps_);
+  FormationPose at;
+  const FormationPose rest = (within && canIssue) || decide ? predictRest(seen, inForce, at) : FormationPose();
+  previous_ = seen.pose;
+  previousStep_ = step;
+  // Reached: there now, and still there once the stop (applying from the apply step) has brought
+  // the formation to rest.
+  if (within && canIssue && (goal_.position - rest.position).norm() <= settings_.positionTolerance &&
+      std::abs(wrapAngle(goal_.yaw - rest.yaw)) <= settings_.yawTolerance) {
     return finish(s, SteeringStep::State::Succeeded);
   }
   // Progress: either error down by half its tolerance since the last progress, or within both
-  // tolerances and settling there (in lockstep a command applies up to a window later, so the
-  // formation can sit within tolerance, still moving, for longer than the patience).
+  // tolerances (settling there). None for the patience, counted once the commands can act.
   bool progressed = within;
   if (s.distance <= bestDistance_ - 0.5 * settings_.positionTolerance) {
     bestDistance_ = s.distance;
@@ -125,23 +198,28 @@ SteeringStep GoalSteering::update(long step, const FormationPose& pose, bool inS
     progressed = true;
   }
   if (progressed) progressStep_ = step;
-  if (step - progressStep_ >= patienceSteps_) {
-    s.reason = "no progress for " + number(settings_.patience) + " s, " + number(s.distance) + " m and " +
-               number(s.yawError) + " rad from the goal: " +
-               (inShape ? std::string("the formation holds its shape but does not follow the commands (blocked?)")
-                        : "the formation is not in its shape (max distance error " + number(maxEdgeError) + " m)");
+  if (step - progressStep_ >= patienceSteps_ + latencySteps_) {
+    s.reason = abortReason(s, seen);
     return finish(s, SteeringStep::State::Aborted);
   }
-  if ((step - startStep_) % periodSteps_ != 0) return s;
-  const double speed = std::min(settings_.maxSpeed, settings_.gain * s.distance);
-  if (s.distance > 0.0) s.velocity.head<2>() = toGoal * (speed / s.distance);
-  s.angularRate.z() = std::clamp(settings_.gain * s.yawError, -settings_.maxTurnRate, settings_.maxTurnRate);
+  if (!decide) return s;
+  // The gain: at most 1 / dT, dT the longest this command can stand before the next applies (the
+  // period, then the next apply step), and at most kappa / 4 (real roots of s^2 + kappa s + kappa g).
+  const double standing = static_cast<double>(periodSteps_ + applyGap_) * timeStep_;
+  const double gain = std::min({settings_.gain, 1.0 / standing, dampingGain_ / 4.0});
+  const Eigen::Vector2d ahead = goal_.position - at.position;
+  const double distance = ahead.norm(), yawError = wrapAngle(goal_.yaw - at.yaw);
+  const double speed = std::min(settings_.maxSpeed, gain * distance);
+  if (distance > 0.0) s.velocity.head<2>() = ahead * (speed / distance);
+  s.angularRate.z() = std::clamp(gain * yawError, -settings_.maxTurnRate, settings_.maxTurnRate);
   // A command only if it changes what the formation does: each is one more in the issued list.
   const bool changed = (s.velocity - lastVelocity_).norm() > 0.01 * settings_.maxSpeed ||
                        (s.angularRate - lastAngularRate_).norm() > 0.01 * settings_.maxTurnRate;
   if (!commanded_ || changed) {
     s.command = true;
     commanded_ = true;
+    applyStep_ = seen.applyStep;
+    decidedStep_ = step;
     lastVelocity_ = s.velocity;
     lastAngularRate_ = s.angularRate;
   }

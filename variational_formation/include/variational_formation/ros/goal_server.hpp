@@ -30,8 +30,9 @@ class GoalServer {
   /// Reads ~goal_* from `pnh` (@throws InvalidInput), advertises in `nh`.
   GoalServer(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Scenario& scenario, const std::string& worldFrame,
              Offer offer);
-  /// Completed step `step` at q (d x n) [m]: `inShape` congruent, `maxEdgeError` [m].
-  void onStep(long step, const Positions& q, bool inShape, double maxEdgeError, const ros::Time& stamp);
+  /// Completed step `seen.step` at q (d x n) [m] (seen.pose is filled here), under the commands
+  /// `inForce` (the desk's schedule).
+  void onStep(GoalObservation seen, const Positions& q, const CommandSchedule& inForce, const ros::Time& stamp);
   /// The run is over: an active goal is aborted with `why`, new ones too.
   void end(const std::string& why);
 
@@ -44,6 +45,9 @@ class GoalServer {
   void stopFormation();
 
   Positions desired_;
+  long steps_;         // the scenario's (0: unbounded)
+  double timeStep_;    // h [s]
+  FormationPose now_;  // the centroid at lastStep_ (the start before any)
   std::string worldFrame_;
   Offer offer_;
   GoalSteering steering_;

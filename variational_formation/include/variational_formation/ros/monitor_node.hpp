@@ -121,7 +121,10 @@ class MonitorNode {
 
   // Goals (src/ros/monitor_goals.cpp): move_to and move_base_simple/goal, steered through desk_.
   void setUpGoals(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  /// A published step for the goal: `constrained` a safety constraint bound at it.
+  void steerGoal(const FormationSnapshot& s, bool constrained, const ros::Time& stamp);
   std::unique_ptr<GoalServer> goals_;
+  long goalCommandsAt_ = -1;  ///< where the Ready being carried out issues commands (-1: nowhere)
 
   // The formation's kappa (src/ros/monitor_parameters.cpp, doc/ros_api.md "monitor"): a
   // dynamic_reconfigure server in the formation's namespace, whose latched parameter_updates the
