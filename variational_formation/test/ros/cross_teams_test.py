@@ -52,7 +52,7 @@ class CrossTeams(unittest.TestCase):
                 for t in TEAMS for i in range(cls.scenario[t]["n"])]
         subs += [rospy.Subscriber(f"/{t}/formation/status", FormationStatus, cls.status[t].append, queue_size=1000)
                  for t in TEAMS]
-        subs.append(rospy.Subscriber("/rosout_agg", Log, cls.on_log, queue_size=1000))
+        subs.append(rospy.Subscriber("/rosout", Log, cls.on_log, queue_size=1000))  # from each node itself
         cls.results = {t: vf_rostest.wait_for_result(os.path.join(cls.out, f"{t}_cross_{t}.result.yaml"), 120.0)
                        for t in TEAMS}
         for s in subs:
