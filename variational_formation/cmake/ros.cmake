@@ -2,8 +2,8 @@
 add_library(variational_formation_ros
   src/ros/agent_commands.cpp
   src/ros/agent_node.cpp
-  src/ros/agent_sensing.cpp
   src/ros/agent_recovery.cpp
+  src/ros/agent_sensing.cpp
   src/ros/bag_writer.cpp
   src/ros/formation_subscriptions.cpp
   src/ros/frame_broadcaster.cpp
