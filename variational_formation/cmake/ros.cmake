@@ -149,8 +149,10 @@ if(CATKIN_ENABLE_TESTING)
   add_rostest(test/ros/safety_run.test ARGS rate:=0)
   add_rostest(test/ros/safety_run.test ARGS fault:=kill)
   add_rostest(test/ros/safety_run.test ARGS fault:=kill nodelet:=true)
-  # Two formations with safety sent across each other keep r apart (avoid, doc/maths.md §10).
+  # Two formations with safety sent across each other keep r apart (avoid, doc/maths.md §10),
+  # lockstep (equal to simulate until the filter binds on the other team) and timed.
   add_rostest(test/ros/cross_teams.test)
+  add_rostest(test/ros/cross_teams.test ARGS mode:=timed)
   # live_tf: tf lookups at now() during a default run (/clock, /use_sim_time).
   foreach(t two_formations two_teams launch live_tf)
     add_rostest(test/ros/${t}.test)

@@ -10,8 +10,11 @@ and, at each state, measures the distance to the other team's agents as last hea
 - each result file reports closest_foreign_approach (an agent of its own team and the other's
   full name, at least 0.9 r) and foreign_constraint_steps > 0, and the statuses carry the closest
   foreign pair with both names;
-- each monitor says once that the filter bound on an agent of another formation (a lockstep run
-  then no longer equals simulate).
+- each monitor says once that the filter bound on an agent of another formation;
+- lockstep: every state before the first step whose filter bound on the other team's agent
+  (foreign_constraints_active) equals simulate's bit for bit, and the run departs from simulate
+  after it; timed mode (mode:=timed, r widened by age x max_speed): the agents' states say their
+  filter bound on the other team.
 """
 import math
 import os
@@ -39,6 +42,7 @@ class CrossTeams(unittest.TestCase):
     def setUpClass(cls):
         rospy.init_node("cross_teams_test")
         cls.out = rospy.get_param("~output_dir")
+        cls.mode = rospy.get_param("~mode", "lockstep")
         here = os.path.dirname(os.path.abspath(__file__))
         cls.scenario = {t: vf_rostest.load_scenario(os.path.join(here, f"cross_team_{t[-1]}.yaml")) for t in TEAMS}
         cls.r = cls.scenario["team_a"]["safety"]["radius"]
@@ -46,6 +50,8 @@ class CrossTeams(unittest.TestCase):
         cls.newest = {t: {} for t in TEAMS}  # agent id -> position, as last heard
         cls.closest = (math.inf, None)
         cls.states = 0
+        cls.heard = {t: {} for t in TEAMS}  # (agent, step) -> position
+        cls.first_bound = {t: math.inf for t in TEAMS}  # first step with foreign_constraints_active > 0
         cls.status = {t: [] for t in TEAMS}
         cls.bound_lines = {t: [] for t in TEAMS}
         subs = [rospy.Subscriber(f"/{t}/formation/agent_{i}/state", AgentState, cls.on_state, t, queue_size=1000)
@@ -66,6 +72,9 @@ class CrossTeams(unittest.TestCase):
         with cls.lock:
             cls.states += 1
             cls.newest[team][msg.id] = list(msg.position)
+            cls.heard[team][(msg.id, msg.step)] = list(msg.position)
+            if msg.foreign_constraints_active > 0:
+                cls.first_bound[team] = min(cls.first_bound[team], msg.step)
             for j, q in cls.newest[other].items():
                 d = math.dist(msg.position, q)
                 if d < cls.closest[0]:
@@ -108,6 +117,22 @@ class CrossTeams(unittest.TestCase):
             self.assertGreaterEqual(min(s.closest_foreign_approach for s in heard), 0.9 * self.r, t)
             self.assertAlmostEqual(min(s.closest_foreign_approach for s in heard),
                                    self.results[t]["closest_foreign_approach"]["distance"], delta=1e-9)
+
+    def test_lockstep_equals_simulate_until_a_foreign_agent_binds(self):
+        for t in TEAMS:
+            self.assertTrue(math.isfinite(self.first_bound[t]), f"{t}: no state says its filter bound on the other team")
+            if self.mode != "lockstep":
+                continue
+            expected = vf_rostest.simulate(vf_rostest.scenario_path(
+                os.path.join(os.path.dirname(os.path.abspath(__file__)), f"cross_team_{t[-1]}.yaml")))
+            before = [k for k in self.heard[t] if k[1] < self.first_bound[t]]
+            self.assertGreater(len(before), 4 * 300, f"{t}: {len(before)} states before step {self.first_bound[t]}")
+            wrong = [k for k in before if self.heard[t][k] != expected[k]]
+            self.assertEqual(wrong, [], f"{t}: states before step {self.first_bound[t]} that differ from simulate")
+            after = [k for k in self.heard[t] if k[1] > self.first_bound[t] and self.heard[t][k] != expected[k]]
+            self.assertTrue(after, f"{t}: the filter bound on the other team, yet the run still equals simulate")
+            print(f"{t}: {len(before)} states equal simulate before step {self.first_bound[t]}; "
+                  f"{len(after)} differ after it", flush=True)
 
     def test_each_monitor_says_once_that_the_run_no_longer_equals_simulate(self):
         for t in TEAMS:
