@@ -168,13 +168,13 @@ AvoidList avoidParameter(const ros::NodeHandle& pnh) {
     return list;
   }
   if (entries.empty()) {
-    throw InvalidInput("avoid: got '" + value + "'; expected \"all\", \"none\" or formation namespaces (team_b)");
+    throw InvalidInput(key + ": got '" + value + "'; expected \"all\", \"none\" or formation namespaces (team_b)");
   }
   list.everyOther = false;
   static const std::regex name("^/?[A-Za-z][A-Za-z0-9_/]*$");
   for (const std::string& e : entries) {
     if (e == "all" || e == "none" || !std::regex_match(e, name)) {
-      throw InvalidInput("avoid: '" + e + "' in '" + value + "' is not a namespace (\"all\" and \"none\" stand alone)");
+      throw InvalidInput(key + ": '" + e + "' in '" + value + "' is not a namespace (\"all\" and \"none\" stand alone)");
     }
     list.namespaces.push_back(normalised(e));
   }

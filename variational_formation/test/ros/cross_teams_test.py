@@ -14,11 +14,13 @@ and, at each state, measures the distance to the other team's agents as last hea
 - lockstep: every state before the first step whose filter bound on the other team's agent
   (foreign_constraints_active) equals simulate's bit for bit, and the run departs from simulate
   after it; timed mode (mode:=timed, r widened by age x max_speed): the agents' states say their
-  filter bound on the other team.
+  filter bound on the other team;
+- a bad `avoid` is one FATAL line naming the parameter and the value, and exit status 2.
 """
 import math
 import os
 import shutil
+import subprocess
 import sys
 import threading
 import unittest
@@ -138,6 +140,16 @@ class CrossTeams(unittest.TestCase):
         for t in TEAMS:
             self.assertEqual(len(self.bound_lines[t]), 1, f"{t}: {self.bound_lines[t]}")
             self.assertIn("no longer equals simulate", self.bound_lines[t][0])
+
+    def test_a_bad_avoid_is_one_fatal_line(self):
+        here = os.path.dirname(os.path.abspath(__file__))
+        run = subprocess.run(["rosrun", PKG, "agent", "__ns:=/bad_avoid/formation", "__name:=agent_0", "_id:=0",
+                              f"_scenario:={here}/cross_team_a.yaml", "_avoid:=all team_b"],
+                             capture_output=True, text=True, timeout=60)
+        self.assertEqual(run.returncode, 2, run.stdout + run.stderr)
+        fatal = [line for line in (run.stdout + run.stderr).splitlines() if "FATAL" in line]
+        self.assertEqual(len(fatal), 1, run.stdout + run.stderr)
+        self.assertIn("/bad_avoid/formation/agent_0/avoid: 'all' in 'all team_b' is not a namespace", fatal[0])
 
 
 if __name__ == "__main__":
