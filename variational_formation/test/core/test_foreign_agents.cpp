@@ -11,8 +11,10 @@
 #include <vector>
 
 #include "variational_formation_core/agents/lockstep_agent.hpp"
+#include "variational_formation_core/common/invalid_input.hpp"
 #include "variational_formation_core/model/scenario.hpp"
 #include "variational_formation_core/safety/foreign_agents.hpp"
+#include "variational_formation_core/safety/foreign_watch.hpp"
 #include "variational_formation_core/safety/timed_safety.hpp"
 
 namespace vf {
@@ -159,6 +161,33 @@ TEST(ForeignAgents, TimedModeWidensByAgeTimesMaxSpeed) {
   safety.filter(10.2, q, next);  // 0.1 m: r + 0.1 = 0.4 < 1 m, and the step does not bind
   EXPECT_EQ(next[0], 0.004);
   EXPECT_EQ(safety.foreignConstraintsActive(), 0);
+}
+
+TEST(ForeignWatch, CountsBoundStepsOnceEachAndKeepsTheClosestPairOfTheRun) {
+  auto agents = std::make_shared<ForeignAgents>(2);
+  ForeignWatch watch(agents);
+  EXPECT_EQ(watch.resultLines(), "closest_foreign_approach: ~\nforeign_constraint_steps: 0\n");
+  EXPECT_FALSE(watch.note(3, 0));
+  EXPECT_TRUE(watch.note(4, 1));   // the first: the monitor says so once
+  EXPECT_FALSE(watch.note(4, 2));  // another agent at the same step
+  EXPECT_FALSE(watch.note(6, 1));
+  EXPECT_EQ(watch.constraintSteps(), 2);
+  Positions q(2, 2);
+  q << 0.0, 1.0, 0.0, 0.0;
+  EXPECT_TRUE(std::isinf(watch.observe(1, q).distance));  // nobody heard yet
+  const double p[2] = {1.0, 0.75};
+  agents->hold("/team_b/formation/agent_2", p, p, 0.0);
+  EXPECT_DOUBLE_EQ(watch.observe(2, q).distance, 0.75);
+  q(1, 1) = 0.25;
+  EXPECT_DOUBLE_EQ(watch.observe(3, q).distance, 0.5);
+  q(1, 1) = 0.0;
+  EXPECT_DOUBLE_EQ(watch.observe(4, q).distance, 0.75);  // the status: now; the run: its closest
+  EXPECT_DOUBLE_EQ(watch.closestApproach().distance, 0.5);
+  EXPECT_EQ(watch.closestApproachStep(), 3);
+  EXPECT_EQ(watch.resultLines(),
+            "closest_foreign_approach: {distance: 0.5, agents: [agent_1, /team_b/formation/agent_2], step: 3}\n"
+            "foreign_constraint_steps: 2\n");
+  EXPECT_THROW(ForeignWatch(nullptr), InvalidInput);
 }
 
 }  // namespace
