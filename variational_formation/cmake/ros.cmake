@@ -3,6 +3,7 @@ add_library(variational_formation_ros
   src/ros/agent_commands.cpp
   src/ros/agent_node.cpp
   src/ros/agent_recovery.cpp
+  src/ros/agent_sensing.cpp
   src/ros/bag_writer.cpp
   src/ros/formation_subscriptions.cpp
   src/ros/frame_broadcaster.cpp
@@ -25,7 +26,7 @@ target_sources(variational_formation_ros PRIVATE src/ros/lockstep_monitor.cpp sr
   src/ros/monitor_parameters.cpp src/ros/timed_monitor.cpp src/ros/monitor_outputs.cpp
   src/ros/monitor_shape.cpp src/ros/monitor_robots.cpp src/ros/monitor_goals.cpp src/ros/goal_server.cpp src/ros/monitor_safety.cpp
   src/ros/recorder_bag.cpp src/ros/recorder_commands.cpp
-  src/ros/sensing_hub.cpp src/ros/service_call.cpp src/ros/state_batch.cpp src/ros/periodic_call.cpp src/ros/pacer.cpp src/ros/trails.cpp)
+  src/ros/sensing_hub.cpp src/ros/foreign_formations.cpp src/ros/service_call.cpp src/ros/state_batch.cpp src/ros/periodic_call.cpp src/ros/pacer.cpp src/ros/trails.cpp)
 add_dependencies(variational_formation_ros ${PROJECT_NAME}_gencfg)
 # The bag writer's LZ4 frames (liblz4, Debian's liblz4-dev).
 find_path(VF_LZ4_INCLUDE_DIR lz4frame.h)
@@ -150,6 +151,10 @@ if(CATKIN_ENABLE_TESTING)
   add_rostest(test/ros/safety_run.test ARGS rate:=0)
   add_rostest(test/ros/safety_run.test ARGS fault:=kill)
   add_rostest(test/ros/safety_run.test ARGS fault:=kill nodelet:=true)
+  # Two formations with safety sent across each other keep r apart (avoid, doc/maths.md §10),
+  # lockstep (equal to simulate until the filter binds on the other team) and timed.
+  add_rostest(test/ros/cross_teams.test)
+  add_rostest(test/ros/cross_teams.test ARGS mode:=timed)
   # live_tf: tf lookups at now() during a default run (/clock, /use_sim_time).
   foreach(t two_formations two_teams launch live_tf)
     add_rostest(test/ros/${t}.test)

@@ -4,7 +4,7 @@ if(CATKIN_ENABLE_TESTING)
     timed_agent link_faults point_robot unicycle_robot record_ledger layers manoeuvre lockstep_manoeuvre monitor
     rigidity slot_assignment shape_outcome safety_filter spatial_grid safety_scenario blocked_detector
     sparse_spectrum goal_steering timed_safety safety_watch sensing_board robot_shape_watch referee_ready
-    local_exchange topic_audience yaml_text)
+    local_exchange topic_audience yaml_text foreign_agents)
   foreach(name ${VF_CORE_TESTS} command_desk)
     vf_add_gtest(test_${name} test/core/test_${name}.cpp "${variational_formation_core_LIBRARIES}")
   endforeach()

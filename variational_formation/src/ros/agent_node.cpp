@@ -22,7 +22,6 @@ namespace vf {
 namespace {
 constexpr double kReportEvery = 5.0;  // seconds between "waiting for ..." lines
 constexpr double kMonitorWait = 2.0;  // seconds a resumed agent in a manager waits for the monitor to connect
-
 }  // namespace
 
 AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
@@ -38,8 +37,10 @@ AgentNode::AgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   const std::shared_ptr<SensingBoard> board = SensingHub::board(nh, scenario, managers_);
   sharedBoard_ = board != nullptr;
   formation_ = sharedFormation(shared);
+  LockstepAgent lockstep(shared, formation_, id, StartMethod::Variational, board);
+  avoidOtherFormations(nh, pnh, lockstep);
   protocol_ = std::make_unique<Protocol>(
-      LockstepAgent(shared, formation_, id, StartMethod::Variational, board),
+      std::move(lockstep),
       [this](const LockstepAgent& a, const std::string& failure) { return makeState(a, failure); }, realTimeFactor_,
       [] { return ros::WallTime::now().toSec(); }, Pacer::kGrain);
   name_ = "agent_" + std::to_string(id);
@@ -93,27 +94,6 @@ AgentNode::~AgentNode() {
   *alive_ = false;
   inboxReader_->node = nullptr;
   Pacer::instance().cancel(reinterpret_cast<uint64_t>(this));
-}
-
-std::vector<int> AgentNode::sources() const {
-  if (!agent().board() || sharedBoard_) return agent().neighbourIds();
-  std::vector<int> all;
-  for (int j = 0; j < agent().scenario().agentCount(); ++j) {
-    if (j != agent().id()) all.push_back(j);
-  }
-  return all;
-}
-
-void AgentNode::wakeWhenSensed() {
-  if (!sharedBoard_ || wakeStep_ == agent().step()) return;
-  wakeStep_ = agent().step();
-  ros::CallbackQueueInterface* queue = nh_.getCallbackQueue();
-  const std::shared_ptr<bool> alive = alive_;
-  agent().board()->whenComplete(agent().step(), [this, queue, alive] {
-    queue->addCallback(boost::make_shared<QueuedCall>([this, alive] {
-      if (*alive) carryOut(protocol_->step(Protocol::Wake{}));
-    }), reinterpret_cast<uint64_t>(this));
-  });
 }
 
 void AgentNode::drop(const std::string& why) {
@@ -185,6 +165,7 @@ AgentState::ConstPtr AgentNode::makeState(const LockstepAgent& a, const std::str
   msg.previous_position = a.previousPosition();
   msg.dropped = static_cast<uint32_t>(dropped_);
   msg.constraints_active = static_cast<uint32_t>(a.constraintsActive());
+  msg.foreign_constraints_active = static_cast<uint32_t>(a.foreignConstraintsActive());
   msg.failure = failure;
   return state;
 }

@@ -13,6 +13,7 @@
 #include "variational_formation_core/model/validation.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/formation_subscriptions.hpp"
+#include "variational_formation/ros/foreign_formations.hpp"
 #include "variational_formation/ros/frames.hpp"
 #include "variational_formation/ros/liveness.hpp"
 #include "variational_formation/ros/participant_names.hpp"
@@ -57,7 +58,7 @@ TimedAgentNode::TimedAgentNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   posePub_ = nh.advertise<geometry_msgs::PoseStamped>(name_ + "/pose", 10);
   worldFrame_ = worldFrame(pnh);
   if (robot_) setUpRobot(nh, pnh, scenario, id);
-  if (scenario.safety) setUpSafety(scenario);
+  if (scenario.safety) setUpSafety(pnh, scenario);
   // With safety on every agent may come near: the filter hears them all (doc/robots.md "Safety").
   std::vector<int> heard = agent_->neighbourIds();
   if (agent_->safety()) {
@@ -116,13 +117,16 @@ void TimedAgentNode::onNeighbourState(int neighbour, const ros::MessageEvent<Age
   faults_->offer({static_cast<int>(msg.id) == neighbour ? neighbour : -1, msg}, now());
 }
 
-void TimedAgentNode::setUpSafety(const Scenario& scenario) {
+void TimedAgentNode::setUpSafety(const ros::NodeHandle& pnh, const Scenario& scenario) {
   // Robot mode: the link saturates cmd_vel at ~max_speed, so that bounds the robots when the
   // scenario gives no safety.max_speed (doc/robots.md "Safety"); timed mode needs the scenario's.
   const double robotSpeed = robot_ ? link_->settings().hand.maxSpeed : std::numeric_limits<double>::quiet_NaN();
   const bool unicycle = robot_ && link_->settings().kinematics == RobotKinematics::Unicycle;
   const double handOffset = unicycle ? link_->settings().hand.handOffset : 0.0;
   agent_->enableSafety(scenario, timedSafetySpeed(*scenario.safety, robotSpeed), handOffset);
+  // Other formations' agents too, as last heard, widened by age x max speed (doc/maths.md §10, avoid).
+  foreign_ = ForeignFormations::watch(nh_, avoidParameter(pnh), scenario.dimension);
+  if (foreign_) agent_->avoid(foreign_->agents());
   const SafetySettings& s = agent_->safety()->settings();
   ROS_INFO("%s: safety filter on: r %g m (%s), sensing radius %g m, gamma %g, max speed %g m/s (%s); every "
            "agent's state is heard, and r widens by age x max speed",

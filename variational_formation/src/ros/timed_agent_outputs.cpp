@@ -102,6 +102,7 @@ void TimedAgentNode::publish() {
   msg.previous_position = agent_->previousPosition();
   msg.dropped = static_cast<uint32_t>(dropped_ + agent_->dropped());
   msg.constraints_active = static_cast<uint32_t>(agent_->constraintsActive());
+  msg.foreign_constraints_active = static_cast<uint32_t>(agent_->foreignConstraintsActive());
   statePub_.publish(msg);
   lastPublishAt_ = ros::WallTime::now();
 

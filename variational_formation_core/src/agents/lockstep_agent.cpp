@@ -164,11 +164,21 @@ std::vector<int> LockstepAgent::missingSensed(std::size_t limit) const {
 // doc/maths.md §10, as SafetyStage::apply: after the update, from q_k and the sensed q_j^k.
 void LockstepAgent::filter(double* next) {
   previousConstraintsActive_ = constraintsActive_;
+  previousForeignConstraintsActive_ = foreignConstraintsActive_;
   if (!board_) return;
   board_->sensed(id_, step_, sensed_);
+  const int n = scenario_->agentCount();
+  // Other formations' agents within reach, after the formation's own (ids from n on, ascending).
+  if (foreign_) {
+    foreign_->sense(q_.data(), scenario_->safety->sensingRadius, 0.0, ForeignMargin::LastStep, 0.0, n, sensed_);
+  }
   filterNextPosition(*scenario_->safety, coefficients_.timeStep, dimension_, q_.data(), next, sensed_,
                      scenario_->obstacles, safeStep_);
   constraintsActive_ = static_cast<int>(safeStep_.projection.active.size());
+  foreignConstraintsActive_ = 0;
+  for (int m : safeStep_.projection.active) {
+    if (safeStep_.constraints[static_cast<std::size_t>(m)].source >= n) ++foreignConstraintsActive_;
+  }
 }
 
 void LockstepAgent::advance() {
@@ -225,6 +235,7 @@ void LockstepAgent::resume(long step, const std::vector<double>& position,
   qBeforePrev_ = previousPosition;
   advanced_ = false;
   constraintsActive_ = 0;
+  foreignConstraintsActive_ = 0;
   offerOwn();
 }
 
@@ -241,6 +252,7 @@ void LockstepAgent::undo() {
   qPrev_.swap(qBeforePrev_);
   --step_;
   constraintsActive_ = previousConstraintsActive_;
+  foreignConstraintsActive_ = previousForeignConstraintsActive_;
 }
 
 }  // namespace vf

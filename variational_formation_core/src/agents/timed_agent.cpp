@@ -156,6 +156,7 @@ TimedAgent::TickResult TimedAgent::tick(double now) {
   }
   tickNow_ = now;
   constraintsActive_ = 0;
+  foreignConstraintsActive_ = 0;
   if (!result.stale.empty()) {
     hold();
   } else {
@@ -237,6 +238,7 @@ void TimedAgent::move(const double* gradient, const ManoeuvreGains* g, const dou
     // doc/robots.md "Safety": the same filter as every run, on the step just computed.
     const SafeStep& filtered = safety_->filter(tickNow_, q_.data(), next.data());
     constraintsActive_ = safety_->constraintsActive();
+    foreignConstraintsActive_ = safety_->foreignConstraintsActive();
     if (filtered.projection.changed) {
       for (int a = 0; a < dimension_; ++a) v_[a] = (next[a] - q_[a]) / h;
     }

@@ -279,8 +279,10 @@ void safetyConstraints(const SafetySettings& s, int d, const double* q, const st
     const double reach = s.sensingRadius + margin, radius = s.radius + margin;
     if (!(zz < (margin == 0.0 ? reach2 : reach * reach))) continue;
     // doc/maths.md §10, pairs: 2 z·δ >= -(γ/2)(|z|^2 - r^2); agent j states the same with -z.
+    // An agent of another formation does not: this one takes the whole, -γ(|z|^2 - r^2).
+    const double share = sensed[j].reciprocates ? 0.5 : 1.0;
     for (int a = 0; a < d; ++a) c.normal[a] *= 2.0;
-    c.bound = std::min(0.0, -0.5 * s.gamma * (zz - (margin == 0.0 ? r2 : radius * radius)));
+    c.bound = std::min(0.0, -share * s.gamma * (zz - (margin == 0.0 ? r2 : radius * radius)));
     c.source = sensed[j].id;
     out.push_back(c);
   }

@@ -63,12 +63,22 @@ const SafeStep& TimedSafety::filter(double now, const double* q, double* qNext) 
     s.margin = stalenessMargin(now - h.sentAt, maxSpeed_);
     sensed_.push_back(s);
   }
+  const int n = static_cast<int>(held_.size());
+  if (foreign_) foreign_->sense(q, settings_.sensingRadius, now, ForeignMargin::Age, maxSpeed_, n, sensed_);
   filterNextPosition(settings_, timeStep_, dimension_, q, qNext, sensed_, obstacles_, step_);
   return step_;
 }
 
 int TimedSafety::constraintsActive() const {
   return static_cast<int>(step_.projection.active.size()) + (step_.projection.speedLimited ? 1 : 0);
+}
+
+int TimedSafety::foreignConstraintsActive() const {
+  int count = 0;
+  for (int m : step_.projection.active) {
+    if (step_.constraints[static_cast<std::size_t>(m)].source >= static_cast<int>(held_.size())) ++count;
+  }
+  return count;
 }
 
 }  // namespace vf

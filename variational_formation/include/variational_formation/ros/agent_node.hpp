@@ -13,6 +13,7 @@
 #include "variational_formation_msgs/RecallHistory.h"
 #include "variational_formation_msgs/RecallState.h"
 #include "variational_formation_msgs/RunProgress.h"
+#include "variational_formation/ros/foreign_formations.hpp"
 #include "variational_formation/ros/frame_broadcaster.hpp"
 #include "variational_formation/ros/local_states.hpp"
 #include "variational_formation_core/protocol/topic_audience.hpp"
@@ -92,8 +93,10 @@ class AgentNode {
   void readInbox();
   /// Advertises the state topic: latched, or with the exchange, gated by the audience.
   void advertiseState(ros::NodeHandle& nh);
-  /// With a shared board: a Wake on this agent's queue once the board holds step k.
+  /// With a shared board: a Wake on this agent's queue once the board holds step k (src/ros/agent_sensing.cpp).
   void wakeWhenSensed();
+  /// With `safety:` and `avoid` not none: `agent` also keeps r from other formations' agents.
+  void avoidOtherFormations(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, LockstepAgent& agent);
   /// Whose states it subscribes to: its neighbours, and with an own board every other agent.
   std::vector<int> sources() const;
   void onProgress(const ros::MessageEvent<RunProgress const>& event);
@@ -125,6 +128,7 @@ class AgentNode {
 
   ros::NodeHandle nh_;
   std::shared_ptr<const Formation> formation_;  // the process's one (sharedFormation): who neighbours whom
+  std::shared_ptr<ForeignFormations> foreign_;  // with safety and avoid: other formations' agents
   std::unique_ptr<Protocol> protocol_;
   // Its own state messages (makeState): the oldest, once nothing else holds it (its step is out
   // of every history, queue and latch), is filled again for the next state. Held longer than 128

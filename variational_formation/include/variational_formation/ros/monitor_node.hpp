@@ -23,6 +23,8 @@
 #include "variational_formation_core/robots/robot_shape_watch.hpp"
 #include "variational_formation_core/agents/run_verdict.hpp"
 #include "variational_formation_core/safety/safety_watch.hpp"
+#include "variational_formation_core/safety/foreign_watch.hpp"
+#include "variational_formation/ros/foreign_formations.hpp"
 #include "variational_formation_core/protocol/command_desk.hpp"
 #include "variational_formation_core/protocol/lockstep_referee.hpp"
 #include "variational_formation_core/protocol/timed_referee.hpp"
@@ -145,7 +147,7 @@ class MonitorNode {
   void setUpSafety(ros::NodeHandle& pnh, bool timed);
   /// An accepted state's constraints_active.
   void noteSafety(int agent, const AgentState& msg);
-  /// Fills the status's min_separation and constraints_active. @return the formation is blocked
+  /// Fills the status's min_separation, constraints_active and closest foreign pair. @return the formation is blocked
   /// (it has just become so: the run ends).
   bool watchSafety(const FormationSnapshot& s, FormationStatus& status);
   /// The result file's safety lines (empty without a safety block).
@@ -252,6 +254,8 @@ class MonitorNode {
   double lastScale_ = 1.0;
   int exitStatus_ = -1;
   std::unique_ptr<SafetyWatch> safety_;  // a scenario with `safety:` only
+  std::shared_ptr<ForeignFormations> foreign_;  // with safety and avoid: the other formations' agents
+  std::unique_ptr<ForeignWatch> foreignWatch_;  // over foreign_
   std::vector<ros::Subscriber> odomSubs_;  // ~measure_robots: robot_<i>/odom
   long badOdometry_ = 0;                   // odometry messages refused (not finite, not a rotation)
   long reportedRobots_ = -2;               // the robots' in-shape stretch already announced (-2: none)

@@ -20,6 +20,7 @@
 #include "variational_formation_core/agents/link_faults.hpp"
 #include "variational_formation_core/robots/robot_link.hpp"
 #include "variational_formation_core/agents/timed_agent.hpp"
+#include "variational_formation/ros/foreign_formations.hpp"
 
 namespace vf {
 
@@ -83,7 +84,7 @@ class TimedAgentNode {
   void sendCommand();
   void setUpRobot(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Scenario& scenario, int id);
   /// The safety filter (a scenario with `safety:`): its max speed and hand offset.
-  void setUpSafety(const Scenario& scenario);
+  void setUpSafety(const ros::NodeHandle& pnh, const Scenario& scenario);
   /// When a state was sent, on now()'s clock [s] (NaN: unknown, the receive time counts).
   double sentAt(const AgentState& state) const;
   void reportWaiting();
@@ -105,6 +106,7 @@ class TimedAgentNode {
   ros::Publisher statePub_, posePub_, setpointPub_, cmdVelPub_;
   std::vector<ros::Subscriber> subs_;
   std::map<int, std::string> owners_;  // full node names of the agents it hears (neighbours; all with safety)
+  std::shared_ptr<ForeignFormations> foreign_;  // with safety and avoid: other formations' agents
   std::map<int, AgentState> newest_;          // each neighbour's newest accepted state, for ~recall
   ros::Subscriber progressSub_, odomSub_, commandSub_, formationParametersSub_;
   std::size_t commandsSeen_ = 0;

@@ -7,6 +7,7 @@
 
 #include "variational_formation_core/manoeuvres/manoeuvre_model.hpp"
 #include "variational_formation_core/agents/agent_neighbourhood.hpp"
+#include "variational_formation_core/safety/foreign_agents.hpp"
 #include "variational_formation_core/safety/safety_filter.hpp"
 #include "variational_formation_core/model/scenario.hpp"
 #include "variational_formation_core/agents/sensing_board.hpp"
@@ -101,6 +102,16 @@ class LockstepAgent {
   /// How many half-spaces bound the filtered step that produced q_k (0 without `safety:`, at
   /// step 0 and after a resume, which does not know it).
   int constraintsActive() const { return constraintsActive_; }
+  /**
+   * With `safety:`, also keeps r from the agents of other formations as last heard (doc/maths.md
+   * §10, "Other formations"): those within reach join the filter's sensed agents after the
+   * formation's own, each margin its last step (ForeignMargin::LastStep). Where none is within
+   * reach the step is unchanged, bit for bit. nullptr: none (the default).
+   */
+  void avoid(std::shared_ptr<const ForeignAgents> foreign) { foreign_ = std::move(foreign); }
+  /// Of the half-spaces constraintsActive() counts, those of other formations' agents: a step
+  /// where this is > 0 depends on another formation's timing, so the run cannot equal simulate.
+  int foreignConstraintsActive() const { return foreignConstraintsActive_; }
 
   int id() const { return id_; }
   long step() const { return step_; }
@@ -158,6 +169,8 @@ class LockstepAgent {
   std::vector<SensedAgent> sensed_;      // reused per step
   SafeStep safeStep_;
   int constraintsActive_ = 0, previousConstraintsActive_ = 0;
+  std::shared_ptr<const ForeignAgents> foreign_;  // other formations' agents (avoid), or nullptr
+  int foreignConstraintsActive_ = 0, previousForeignConstraintsActive_ = 0;
 };
 
 }  // namespace vf

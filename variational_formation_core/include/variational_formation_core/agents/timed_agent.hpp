@@ -90,6 +90,12 @@ class TimedAgent {
   const TimedSafety* safety() const { return safety_ ? &*safety_ : nullptr; }
   /// Half-spaces and speed limit that bound the last tick's step (0 when it held or nothing bound).
   int constraintsActive() const { return constraintsActive_; }
+  /// With safety on: also keep r from other formations' agents (TimedSafety::avoid). Call after enableSafety.
+  void avoid(std::shared_ptr<const ForeignAgents> foreign) {
+    if (safety_) safety_->avoid(std::move(foreign));
+  }
+  /// Of constraintsActive(), the half-spaces of other formations' agents.
+  int foreignConstraintsActive() const { return foreignConstraintsActive_; }
 
   /// One wall-clock tick at time `now`: q_k -> q_{k+1}, or a hold. Never blocks.
   TickResult tick(double now);
@@ -194,7 +200,7 @@ class TimedAgent {
   ManoeuvreGains lastGains_;
   std::optional<TimedSafety> safety_;  // empty: no safety block, or not enabled
   double tickNow_ = 0.0;                 // the current tick's time, for the filter's margins
-  int constraintsActive_ = 0;
+  int constraintsActive_ = 0, foreignConstraintsActive_ = 0;
 };
 
 }  // namespace vf

@@ -55,11 +55,15 @@ struct SensedAgent {
   /// Widens r for this pair to r + margin [m] >= 0, and the sensing radius R to R + margin: where
   /// the position is old (timed and robot mode, doc/robots.md "Safety"). 0 in exact runs.
   double margin = 0.0;
+  /// false: an agent of another formation (ForeignAgents), which does not state the pair's other
+  /// half, so this agent takes the whole constraint, 2 z·δ >= -γ(|z|^2 - (r + m_j)^2) (doc/maths.md §10).
+  bool reciprocates = true;
 };
 
 /**
  * Agent i's half-spaces at q = q_i^{k+1} (doc/maths.md §10), in this order: every sensed agent with
- * |z| < R + m_j, z = q - q_j, as 2 z·δ >= -(γ/2)(|z|^2 - (r + m_j)^2), m_j its margin, in the order given; then every obstacle k
+ * |z| < R + m_j, z = q - q_j, as 2 z·δ >= -(γ/2)(|z|^2 - (r + m_j)^2), m_j its margin (-γ(...) for one
+ * that does not reciprocate), in the order given; then every obstacle k
  * with |w| < R, w = q - p_k, as 2 w·δ >= -γ(|w|^2 - (r/2)^2), in list order. Agents farther than R
  * may be passed (they are skipped), so a caller can pass every candidate of a grid's cells.
  * A gap already below r (by at most rounding, in a safe run) gives b = 0: no closer, and δ = 0

@@ -2,6 +2,9 @@
 
 #include <vector>
 
+#include <memory>
+
+#include "variational_formation_core/safety/foreign_agents.hpp"
 #include "variational_formation_core/safety/safety_filter.hpp"
 #include "variational_formation_core/model/scenario.hpp"
 
@@ -60,6 +63,15 @@ class TimedSafety {
   double maxSpeed() const { return maxSpeed_; }
   /// Half-spaces and speed limit that bound the last filtered step (AgentState.constraints_active).
   int constraintsActive() const;
+  /**
+   * Also keeps r from the agents of other formations as last heard (doc/maths.md §10, "Other
+   * formations"), as from the formation's own: each widened by its age x maxSpeed
+   * (ForeignMargin::Age; `sentAt` of ForeignAgents::hold on the clock of filter()'s `now`).
+   * nullptr: none (the default).
+   */
+  void avoid(std::shared_ptr<const ForeignAgents> foreign) { foreign_ = std::move(foreign); }
+  /// Of constraintsActive(), the half-spaces of other formations' agents.
+  int foreignConstraintsActive() const;
 
  private:
   struct Held {
@@ -73,6 +85,7 @@ class TimedSafety {
   int dimension_, id_;
   std::vector<Held> held_;  // by agent id
   std::vector<SensedAgent> sensed_;
+  std::shared_ptr<const ForeignAgents> foreign_;
   SafeStep step_;
 };
 
