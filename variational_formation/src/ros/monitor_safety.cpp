@@ -32,7 +32,7 @@ void MonitorNode::noteSafety(int agent, const AgentState& msg) {
 bool MonitorNode::watchSafety(const FormationSnapshot& s, FormationStatus& status) {
   if (!safety_ || ended()) return false;
   const bool wasBlocked = safety_->blocked();
-  const bool blocked = safety_->observe(s.metrics.step, s.positions, s.metrics.maxDistanceError, s.converged);
+  const bool blocked = safety_->observe(s.metrics.step, s.positions, s.metrics.maxDistanceError, s.congruent);
   status.min_separation = safety_->minSeparation();
   status.constraints_active = static_cast<uint32_t>(safety_->constraintsActive());
   if (status.min_separation < scenario_.safety->radius) {

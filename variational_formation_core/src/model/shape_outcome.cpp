@@ -14,8 +14,10 @@ ShapeFindings findShape(const Formation& formation, const Positions& q, const Ve
   ShapeFindings f;
   f.shapeError = withShapeError ? formation.shapeError(q, scale) : std::numeric_limits<double>::quiet_NaN();
   f.maxEdgeError = formation.maxDistanceError(q, scale);
+  f.fastestSpeed = v.cols() > 0 ? v.colwise().norm().maxCoeff() : 0.0;
   f.congruent = congruent;
-  f.edgesConverged = formation.allSlowerThan(v, maxSpeed) && formation.edgesWithin(q, tolerance, scale);
+  f.edgesWithin = formation.edgesWithin(q, tolerance, scale);
+  f.atRest = f.fastestSpeed < restSpeed(maxSpeed);
   // A congruent shape cannot change hands without passing through a flat one, which is not
   // congruent: while it stays congruent this answer holds.
   f.mirrored = congruent && (knownMirror ? *knownMirror : isMirrorImage(q, formation.desiredShape(), tolerance));
@@ -35,6 +37,18 @@ bool shapeErrorMeasuredAt(long step, int agents, long lastStep) {
   return every <= 1 || step % every == 0 || (lastStep > 0 && step == lastStep);
 }
 
+std::string verdictName(const ShapeOutcome& outcome) {
+  if (!outcome.blocked.empty()) return "blocked";
+  switch (outcome.verdict) {
+    case ShapeVerdict::DesiredShape: return "desired_shape";
+    case ShapeVerdict::MirrorImage: return "mirror_image";
+    case ShapeVerdict::Folded: return "folded";
+    case ShapeVerdict::StillSettling: return "still_settling";
+    case ShapeVerdict::NotConverged: break;
+  }
+  return "not_converged";
+}
+
 ShapeOutcome shapeOutcome(const ShapeFindings& findings, long congruentSince, bool mirrorAllowed, double timeStep) {
   ShapeOutcome o;
   o.findings = findings;
@@ -44,10 +58,23 @@ ShapeOutcome shapeOutcome(const ShapeFindings& findings, long congruentSince, bo
     o.convergedStep = congruentSince;
     std::snprintf(text, sizeof text, "converged to the desired shape at step %ld (t = %.3f s)%s", congruentSince,
                   congruentSince * timeStep, findings.mirrored ? ", its mirror image (mirror: allowed)" : "");
-  } else if (findings.edgesConverged) {
-    o.verdict = ShapeVerdict::OtherShape;
-    std::snprintf(text, sizeof text, "edges converged but the shape is not the desired one (%sshape error %.3g m)",
-                  findings.mirrored ? "its mirror image; " : "", findings.shapeError);
+  } else if (findings.congruent) {
+    o.verdict = ShapeVerdict::MirrorImage;
+    std::snprintf(text, sizeof text,
+                  "not converged: the mirror image of the desired shape from step %ld (t = %.3f s; mirror: forbidden)",
+                  congruentSince, congruentSince * timeStep);
+  } else if (findings.edgesWithin && findings.atRest) {
+    o.verdict = ShapeVerdict::Folded;
+    std::snprintf(text, sizeof text,
+                  "not converged: folded, at rest with every edge within tolerance but not every pair (shape error "
+                  "%.3g m)",
+                  findings.shapeError);
+  } else if (findings.edgesWithin) {
+    o.verdict = ShapeVerdict::StillSettling;
+    std::snprintf(text, sizeof text,
+                  "not converged: still settling at the last step (every edge within tolerance; shape error %.3g m; "
+                  "fastest agent %.3g m/s)",
+                  findings.shapeError, findings.fastestSpeed);
   } else {
     std::snprintf(text, sizeof text, "not converged (final max distance error %.3g m)", findings.maxEdgeError);
   }

@@ -10,10 +10,22 @@ namespace vf {
 struct ShapeFindings {
   double shapeError = 0.0;     ///< Formation::shapeError, over all pairs [m]
   double maxEdgeError = 0.0;   ///< Formation::maxDistanceError, over the edges [m]
+  double fastestSpeed = 0.0;   ///< the fastest agent's speed relative to the commanded motion [m/s]
   bool congruent = false;      ///< every pair within tolerance, every agent slow (as given)
-  bool edgesConverged = false; ///< every edge within tolerance, every agent slow
+  bool edgesWithin = false;    ///< every edge within tolerance, at any speed
+  bool atRest = false;         ///< every agent slower than restSpeed(maxSpeed)
   bool mirrored = false;       ///< congruent, and with the mirror image of the desired shape (isMirrorImage)
 };
+
+/**
+ * Below this speed [m/s] an agent is at rest: a hundredth of the congruence's speed limit
+ * `maxSpeed` (0.001 m/s with the monitor's 0.1). A formation with every edge within tolerance
+ * whose agents are not all at rest is still settling, not folded: a distance error can only
+ * fall while agents move, and at the end of a run too short to settle they move at 0.02 to
+ * 0.04 m/s (the hexagon at step 300), at a fold they have come to rest (below 1e-5 m/s after
+ * 1500 steps in benchmark/deployments.py).
+ */
+inline double restSpeed(double maxSpeed) { return 0.01 * maxSpeed; }
 
 /**
  * The findings at one configuration q [m] with velocities v relative to the commanded motion
@@ -37,8 +49,13 @@ ShapeFindings findShape(const Formation& formation, const Positions& q, const Ve
  */
 bool shapeErrorMeasuredAt(long step, int agents, long lastStep);
 
-/// The three endings of a run.
-enum class ShapeVerdict { DesiredShape, OtherShape, NotConverged };
+/**
+ * The endings of a run: the desired shape (converged); its mirror image (every pair right, but
+ * left and right swapped, with `mirror: forbidden`); folded (every edge within tolerance, not
+ * every pair, at rest); still settling (every edge within tolerance, not in shape, still moving
+ * at the last step); not converged (some edge off, or blocked). Only the first is "converged".
+ */
+enum class ShapeVerdict { DesiredShape, MirrorImage, Folded, StillSettling, NotConverged };
 
 struct ShapeOutcome {
   ShapeVerdict verdict = ShapeVerdict::NotConverged;
@@ -47,12 +64,17 @@ struct ShapeOutcome {
   /// Why the run stopped short of the shape under a safety filter ("blocked: agents 2, 4",
   /// BlockedDetector::description()), or empty; set by blockedShapeOutcome.
   std::string blocked;
-  /// "converged to the desired shape at step K (t = T s)",
-  /// "edges converged but the shape is not the desired one (shape error E m)" (with "its mirror
-  /// image; " before the shape error for a mirror image), or
-  /// "not converged (final max distance error E m)".
+  /// "converged to the desired shape at step K (t = T s)", and otherwise a line starting "not
+  /// converged": ": the mirror image of the desired shape from step K (t = T s; mirror:
+  /// forbidden)", ": folded, at rest with every edge within tolerance but not every pair (shape
+  /// error E m)", ": still settling at the last step (every edge within tolerance; shape error E m;
+  /// fastest agent V m/s)" or " (final max distance error E m)".
   std::string line;
 };
+
+/// The result file's `verdict:` value: desired_shape, mirror_image, folded, still_settling or
+/// not_converged, and blocked for a blockedShapeOutcome.
+std::string verdictName(const ShapeOutcome& outcome);
 
 /// The outcome of a run that the safety filter blocked: not converged, with line
 /// "not converged (blocked: agents 2, 4)"; the findings are kept.
@@ -60,7 +82,8 @@ ShapeOutcome blockedShapeOutcome(ShapeOutcome outcome, const std::string& blocke
 
 /**
  * The verdict at the last step: the desired shape if congruent and not mirrored (or mirrored
- * with mirrorAllowed); another shape if every edge converged; else not converged.
+ * with mirrorAllowed); the mirror image if congruent and mirrored without it; with every edge
+ * within tolerance, folded if at rest and still settling if not; else not converged.
  * @param congruentSince first step of the congruent stretch holding at the last step (-1 if
  * none); @param timeStep h [s].
  */
@@ -77,6 +100,8 @@ class ShapeTracker {
   void observe(long step, const Positions& q, const Velocities& v, double scale);
   /// The outcome at the last observed step. @param timeStep h [s].
   ShapeOutcome outcome(double timeStep) const;
+  /// First step of the congruent stretch (either hand) holding at the last observed step, -1 if none.
+  long congruentSince() const { return congruentSince_; }
 
  private:
   const Formation& formation_;
