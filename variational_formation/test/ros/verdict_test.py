@@ -82,13 +82,13 @@ class VerdictTest(unittest.TestCase):
         with cls.lock:
             cls.statuses.append((msg.step, msg.converged, msg.converged_step))
 
-    def launch(self, path, name):
+    def launch(self, path):
         """run_formation.sh on `path`: (its CompletedProcess, the result file, the statuses seen)."""
         with self.lock:
             self.statuses.clear()
-        out = os.path.join(self.tmp, name)
-        run = run_formation(f"scenario:={path}", f"output_dir:={out}")
         stem = os.path.splitext(os.path.basename(path))[0]
+        out = os.path.join(self.tmp, stem)  # in the logged paths: no "converged" from a name
+        run = run_formation(f"scenario:={path}", f"output_dir:={out}")
         result = vf_rostest.wait_for_result(os.path.join(out, stem + ".result.yaml"), 0)
         rospy.sleep(0.5)  # the last status, published before the result file was written
         with self.lock:
@@ -98,7 +98,7 @@ class VerdictTest(unittest.TestCase):
     def check_run(self, path, verdict, line_start, steps):
         expected = simulate_verdict(path)
         self.assertTrue(expected.startswith(line_start), expected)
-        run, result, statuses = self.launch(path, verdict)
+        run, result, statuses = self.launch(path)
         log = run.stdout + run.stderr
         self.assertEqual(run.returncode, 0, log[-3000:])
         self.assertEqual(result.get("result"), "succeeded", result)
@@ -113,7 +113,7 @@ class VerdictTest(unittest.TestCase):
         self.assertTrue(last, log[-3000:])
         self.assertIn("formation " + expected, last[-1])
         if desired:
-            converged_at = int(expected.split()[6])
+            converged_at = int(expected.split()[7])
             self.assertEqual(result["converged_step"], converged_at)
             self.assertIn("monitor: run succeeded; formation converged", last[-1])
             self.assertTrue(any(f"congruent with the desired shape since step {converged_at} " in line
@@ -147,7 +147,7 @@ class VerdictTest(unittest.TestCase):
         required = os.path.join(self.tmp, "verdict_mirror_required.yaml")
         with open(required, "w") as f:
             f.write(text + "require_convergence: true\n")
-        run, result, _ = self.launch(required, "required")
+        run, result, _ = self.launch(required)
         self.assertNotEqual(run.returncode, 0, run.stdout[-3000:])
         self.assertEqual(result.get("result"), "failed", result)
         self.assertEqual(result["verdict"], "mirror_image")
