@@ -85,6 +85,19 @@ TEST(ShapeOutcome, TellsTheFiveEndingsApartAndSaysConvergedOnlyForTheDesiredShap
   EXPECT_EQ(verdictName(settling), "still_settling");
   creeping(1, 1) = 0.0009;
   EXPECT_EQ(outcome(foldedHexagon(s.desiredPositions), creeping, false).verdict, ShapeVerdict::Folded);
+  // Slow, but a distance error still falling: agent 1 leaves the centre towards its place at
+  // 0.0009 m/s along the line from agent 4, so pair 1-4 (3 m of 6) closes at 0.0009 m/s and
+  // would be within 1 % (2.94 m to go) in 3267 s: still settling over a longer horizon (the
+  // run's own duration), folded over a shorter one.
+  Velocities closing = still;
+  closing.col(1) = 0.0009 * (s.desiredPositions.col(1) - s.desiredPositions.col(4)).normalized();
+  const auto over = [&](double horizon) {
+    return shapeOutcome(findShape(f, foldedHexagon(s.desiredPositions), closing, 1.0, false, 0.01, 0.1, true, nullptr,
+                                  horizon), -1, false, 0.014).verdict;
+  };
+  EXPECT_EQ(over(3300.0), ShapeVerdict::StillSettling);
+  EXPECT_EQ(over(3200.0), ShapeVerdict::Folded);
+  EXPECT_EQ(over(0.0), ShapeVerdict::Folded);  // speeds alone
   Velocities moving = still;
   moving(0, 3) = 0.5;
   EXPECT_EQ(outcome(s.desiredPositions, moving, false).verdict, ShapeVerdict::StillSettling);

@@ -124,7 +124,7 @@ FormationSnapshot FormationMonitor::measureStep(long step, const Positions& qPre
   // The mirror test once per congruent stretch: its answer holds while the shape stays congruent.
   const bool mirrorKnown = s.congruent && congruentSince_ >= 0 && mirrorTested_;
   s.shape = findShape(formation_, q, v, scale, s.congruent, tolerance_, maxSpeed_, measured,
-                      mirrorKnown ? &mirrored_ : nullptr);
+                      mirrorKnown ? &mirrored_ : nullptr, static_cast<double>(step) * h);
   mirrorTested_ = s.congruent;
   mirrored_ = s.shape.mirrored;
   if (!s.congruent) {

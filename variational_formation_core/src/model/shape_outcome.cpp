@@ -8,16 +8,40 @@
 
 namespace vf {
 
+namespace {
+
+/// Some pair outside tolerance whose distance error, falling at its current rate, is within
+/// tolerance in `horizon` seconds (findShape).
+bool closingWithin(const Formation& formation, const Positions& q, const Velocities& v, double scale,
+                   double tolerance, double horizon) {
+  const Positions& desired = formation.desiredShape();
+  for (int i = 0; i < formation.agentCount(); ++i) {
+    for (int j = i + 1; j < formation.agentCount(); ++j) {
+      const Eigen::VectorXd a = q.col(i) - q.col(j);
+      const double length = a.norm(), target = scale * (desired.col(i) - desired.col(j)).norm();
+      const double error = length - target, excess = std::abs(error) - tolerance * target;
+      if (excess <= 0.0 || length == 0.0) continue;
+      const double falling = -(error > 0.0 ? 1.0 : -1.0) * a.dot(v.col(i) - v.col(j)) / length;  // -d|e|/dt
+      if (falling * horizon >= excess) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
 ShapeFindings findShape(const Formation& formation, const Positions& q, const Velocities& v, double scale,
                         bool congruent, double tolerance, double maxSpeed, bool withShapeError,
-                        const bool* knownMirror) {
+                        const bool* knownMirror, double horizon) {
   ShapeFindings f;
   f.shapeError = withShapeError ? formation.shapeError(q, scale) : std::numeric_limits<double>::quiet_NaN();
   f.maxEdgeError = formation.maxDistanceError(q, scale);
   f.fastestSpeed = v.cols() > 0 ? v.colwise().norm().maxCoeff() : 0.0;
   f.congruent = congruent;
   f.edgesWithin = formation.edgesWithin(q, tolerance, scale);
-  f.atRest = f.fastestSpeed < restSpeed(maxSpeed);
+  f.atRest = f.fastestSpeed < restSpeed(maxSpeed) &&
+             !(horizon > 0.0 && withShapeError && f.edgesWithin && !congruent &&
+               closingWithin(formation, q, v, scale, tolerance, horizon));
   // A congruent shape cannot change hands without passing through a flat one, which is not
   // congruent: while it stays congruent this answer holds.
   f.mirrored = congruent && (knownMirror ? *knownMirror : isMirrorImage(q, formation.desiredShape(), tolerance));
@@ -90,6 +114,7 @@ ShapeTracker::ShapeTracker(const Formation& formation, bool mirrorAllowed, doubl
       congruence_(tolerance, maxSpeed) {}
 
 void ShapeTracker::observe(long step, const Positions& q, const Velocities& v, double scale) {
+  step_ = step;
   congruent_ = congruence_.check(formation_, q, v, scale);
   if (!congruent_) {
     congruentSince_ = -1;
@@ -102,7 +127,9 @@ void ShapeTracker::observe(long step, const Positions& q, const Velocities& v, d
 }
 
 ShapeOutcome ShapeTracker::outcome(double timeStep) const {
-  const ShapeFindings f = findShape(formation_, q_, v_, scale_, congruent_, tolerance_, maxSpeed_);
+  // Closing pairs count over the run's own duration t_k, as the monitor counts them.
+  const ShapeFindings f = findShape(formation_, q_, v_, scale_, congruent_, tolerance_, maxSpeed_, true, nullptr,
+                                    static_cast<double>(step_) * timeStep);
   return shapeOutcome(f, congruentSince_, mirrorAllowed_, timeStep);
 }
 

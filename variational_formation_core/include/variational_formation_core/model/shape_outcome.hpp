@@ -13,17 +13,19 @@ struct ShapeFindings {
   double fastestSpeed = 0.0;   ///< the fastest agent's speed relative to the commanded motion [m/s]
   bool congruent = false;      ///< every pair within tolerance, every agent slow (as given)
   bool edgesWithin = false;    ///< every edge within tolerance, at any speed
-  bool atRest = false;         ///< every agent slower than restSpeed(maxSpeed)
+  /// Every agent slower than restSpeed(maxSpeed), and no pair's distance error falling fast enough
+  /// to come within tolerance in another `horizon` (findShape).
+  bool atRest = false;
   bool mirrored = false;       ///< congruent, and with the mirror image of the desired shape (isMirrorImage)
 };
 
 /**
  * Below this speed [m/s] an agent is at rest: a hundredth of the congruence's speed limit
  * `maxSpeed` (0.001 m/s with the monitor's 0.1). A formation with every edge within tolerance
- * whose agents are not all at rest is still settling, not folded: a distance error can only
- * fall while agents move, and at the end of a run too short to settle they move at 0.02 to
- * 0.04 m/s (the hexagon at step 300), at a fold they have come to rest (below 1e-5 m/s after
- * 1500 steps in benchmark/deployments.py).
+ * whose agents are not all at rest is still settling, not folded. Measured: at step 300 of the
+ * hexagon from 30 scattered starts the runs still settling move at 0.021 to 0.032 m/s; the 67
+ * folds of benchmark/deployments.py (1500 steps) below 0.00078 m/s, and the hexagon's folds
+ * after 3000 steps below 1.2e-9 m/s.
  */
 inline double restSpeed(double maxSpeed) { return 0.01 * maxSpeed; }
 
@@ -36,10 +38,15 @@ inline double restSpeed(double maxSpeed) { return 0.01 * maxSpeed; }
  * @param knownMirror the mirror test's answer at an earlier step of the same congruent stretch,
  *        taken as it is (a congruent shape cannot change hands without passing through a flat
  *        one, which is not congruent); nullptr: test it. Ignored when not congruent.
+ * @param horizon [s] a formation with every edge within tolerance, not congruent and every agent
+ *        slow is still not at rest while some pair outside tolerance closes fast enough to come
+ *        within it in this long at its current rate, d|e_ij|/dt = sign(e_ij) (q_i - q_j).(v_i - v_j)
+ *        / |q_i - q_j| (the run's own duration t_k: a distance error still falling). O(n^2), on
+ *        such a formation only, with withShapeError. 0: speeds alone.
  */
 ShapeFindings findShape(const Formation& formation, const Positions& q, const Velocities& v, double scale,
                         bool congruent, double tolerance, double maxSpeed, bool withShapeError = true,
-                        const bool* knownMirror = nullptr);
+                        const bool* knownMirror = nullptr, double horizon = 0.0);
 
 /**
  * Whether a run measures the O(n^2) shape error at `step`: at most a 50-agent cost per step on
@@ -108,6 +115,7 @@ class ShapeTracker {
   bool mirrorAllowed_;
   double tolerance_, maxSpeed_;
   CongruenceTracker congruence_;
+  long step_ = 0;
   long congruentSince_ = -1;
   bool congruent_ = false;
   Positions q_;
