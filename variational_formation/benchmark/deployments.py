@@ -111,8 +111,8 @@ def main():
                 rows.append(dict(line=line, length=path_length, closest=gaps.min(),
                                  time=int(m.group(1)) * 0.02 if m else None,
                                  desired="converged to the desired shape" in line,
-                                 mirror="its mirror image" in line,
-                                 folded="edges converged but" in line,
+                                 mirror="mirror image" in line,
+                                 folded="not converged: folded" in line,
                                  folded_independent=independent_fold(q[-1], desired, edges) if assignment == "none" else None))
             results[(gname, assignment)] = rows
 

@@ -86,8 +86,7 @@ def run_case(bin_dir, tmp, agents, obstacles, safety, runs):
                            capture_output=True, text=True)
         if r.returncode == 2:
             sys.exit(r.stderr)
-        # The last line is the shape's verdict (both cases); under the filter the line before it
-        # says whether the run was blocked.
+        # The last line is the run's one verdict (both cases), blocked runs included.
         lines = r.stdout.splitlines()
         verdict = lines[-1]
         m = re.search(r"at step \d+ \(t = ([0-9.]+) s\)", verdict)
@@ -95,7 +94,7 @@ def run_case(bin_dir, tmp, agents, obstacles, safety, runs):
         q = data[:, 3:5].reshape(-1, agents, 2)
         rows.append(dict(converged=verdict.startswith("formation: converged to the desired shape"),
                          time=float(m.group(1)) if m else None,
-                         blocked=any(ln.startswith("simulate: formation") and "blocked" in ln for ln in lines),
+                         blocked=verdict.startswith("formation: not converged (blocked: "),
                          closest=closest_pair(q), clearance=obstacle_clearance(q) if obstacles else None))
         os.remove(traj)
     return rows, skipped

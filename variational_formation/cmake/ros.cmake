@@ -134,6 +134,8 @@ if(CATKIN_ENABLE_TESTING)
     "case:=mujoco_safety_scattered world:=mujoco kinematics:=unicycle scenario_dir:=test/ros scenario:=scattered6_safety time_limit:=90")
   # The monitor's safety report on a formation the filter blocks (closest approach, blocked).
   add_rostest(test/ros/safety_monitor.test)
+  # One verdict per run (desired, mirror image, folded, still settling, not converged) everywhere.
+  add_rostest(test/ros/verdict.test)
   # render_bag.py on a recorded hexagon: video length, frames, processes left, bad inputs; and on
   # robots.launch's wall-time bag: the video is the run from its first step, one name per robot.
   add_rostest(test/ros/render.test ARGS kind:=formation)

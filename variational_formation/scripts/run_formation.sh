@@ -51,9 +51,11 @@ outcome="$(field result)"
 formation="$(field formation)"
 case "$outcome" in
   succeeded|stopped)
+    # Only "converged to the desired shape ..." is converged; every other verdict starts "not
+    # converged" (its mirror image, folded, still settling, an edge off, blocked).
     case "$formation" in
-      "not converged"*) echo "run_formation: the run $outcome, but the formation did not converge: ${formation#not converged }" >&2 ;;
-      "edges converged"*) echo "run_formation: the run $outcome, but the formation is not in the desired shape: $formation" >&2 ;;
+      "not converged"*) why="${formation#not converged}"; why="${why#: }"; why="${why# }"
+        echo "run_formation: the run $outcome, but the formation did not converge: $why" >&2 ;;
     esac
     exit 0 ;;
   *) echo "run_formation: the run $outcome: $(field reason)" >&2; exit 1 ;;

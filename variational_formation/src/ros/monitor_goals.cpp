@@ -25,7 +25,7 @@ void MonitorNode::setUpGoals(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
 void MonitorNode::steerGoal(const FormationSnapshot& s, bool constrained, const ros::Time& stamp) {
   GoalObservation seen;
   seen.step = s.metrics.step;
-  seen.inShape = s.converged;
+  seen.inShape = s.congruent;  // either hand: a goal steers the shape it holds
   seen.maxEdgeError = s.metrics.maxDistanceError;
   seen.constrained = constrained;
   // The desk issues at most one command per allowed step: past the newest issued one only.

@@ -65,14 +65,16 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
     }
     markersPub_.publish(out.second);
   }
-  convergedStep_ = s.converged ? s.convergedStep : -1;
+  congruentSince_ = s.congruentSince;
   finalError_ = s.metrics.maxDistanceError;
-  if (s.converged && reportedConvergence_ != s.convergedStep) {
-    ROS_INFO("monitor: congruent with the desired shape since step %ld (t = %.3f s)", s.convergedStep,
-             s.convergedStep * scenario_.timeStep);
-    reportedConvergence_ = s.convergedStep;
-  } else if (!s.converged && reportedConvergence_ >= 0) {
-    ROS_INFO("monitor: left the desired shape at step %ld", s.metrics.step);
+  // Congruent in a forbidden mirror image is not converged, and the line says so (ShapeOutcome).
+  const char* shape = s.converged ? "the desired shape" : "the mirror image of the desired shape";
+  if (s.congruent && reportedConvergence_ != s.congruentSince) {
+    ROS_INFO("monitor: congruent with %s since step %ld (t = %.3f s)%s", shape, s.congruentSince,
+             s.congruentSince * scenario_.timeStep, s.converged ? "" : ": not converged (mirror: forbidden)");
+    reportedConvergence_ = s.congruentSince;
+  } else if (!s.congruent && reportedConvergence_ >= 0) {
+    ROS_INFO("monitor: no longer congruent at step %ld", s.metrics.step);
     reportedConvergence_ = -2;
   }
   if (blocked) report(protocol::Blocked{});  // the formation cannot form: say so instead of running on
@@ -97,7 +99,7 @@ void MonitorNode::writeResult(const std::string& result, const std::string& reas
   f << "result: " << result << "\nscenario: " << yamlQuoted(scenario_.name) << "\nsteps: " << scenario_.steps
     << "\ncompleted_step: " << completedStep() << "\nconverged_step: " << formation.convergedStep
     << "\nshape_error: " << formation.findings.shapeError << "\nformation: "
-    << yamlQuoted(formation.line) << "\nfinal_max_distance_error: " << finalError_ << "\ndropped: " << dropped_ << "\ncommands: " << commandsIssued()
+    << yamlQuoted(formation.line) << "\nverdict: " << verdictName(formation) << "\nfinal_max_distance_error: " << finalError_ << "\ndropped: " << dropped_ << "\ncommands: " << commandsIssued()
     << "\ncommands_refused: " << commandsRefused_ << "\ncommands_saturated: " << desk_->saturated()
     << "\nreason: " << yamlQuoted(reason) << "\n" << safetyResultLines() << robotsResultLines();
   // Whole or not at all: a test or script polling the file never reads half of it.
@@ -124,8 +126,12 @@ void MonitorNode::finish(const protocol::Progress& end) {
   }
   if (state == RunProgress::FINISHED) {
     writeResult("succeeded", "");
-    // The last line says whether the formation formed: a run that never formed is no plain success.
-    ROS_INFO("monitor: run succeeded; formation %s (%s)", formation.line.c_str(),
+    // The last line says whether the formation formed: a run that never formed is no plain success,
+    // and the line says what its success is (doc/ros_api.md, "monitor": the result file).
+    const std::string what = formation.verdict == ShapeVerdict::DesiredShape
+                                 ? ""
+                                 : ": all " + std::to_string(last) + " steps ran (the scenario does not require convergence)";
+    ROS_INFO("monitor: run succeeded%s; formation %s (%s)", what.c_str(), formation.line.c_str(),
              resultFile_.empty() ? "no result file" : resultFile_.c_str());
     exitStatus_ = 0;
   } else {

@@ -67,8 +67,9 @@ void MonitorNode::watchRobots(const FormationSnapshot& s, FormationStatus& statu
   status.robots_max_distance_error = r.findings.maxEdgeError;
   status.robots_shape_error = r.findings.shapeError;
   if (r.inShapeSince >= 0 && reportedRobots_ != r.inShapeSince) {
-    ROS_INFO("monitor: the robots (odometry) in the desired shape since step %ld (t = %.3f s)", r.inShapeSince,
-             r.inShapeSince * scenario_.timeStep);
+    ROS_INFO("monitor: the robots (odometry) in %s since step %ld (t = %.3f s)",
+             r.findings.mirrored && !scenario_.mirrorAllowed ? "the mirror image of the desired shape" : "the desired shape",
+             r.inShapeSince, r.inShapeSince * scenario_.timeStep);
     reportedRobots_ = r.inShapeSince;
   } else if (r.inShapeSince < 0 && reportedRobots_ >= 0) {
     const std::string why = r.measured ? "max distance error " + formatRounded(r.findings.maxEdgeError) + " m"

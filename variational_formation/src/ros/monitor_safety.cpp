@@ -50,7 +50,7 @@ bool MonitorNode::watchSafety(const FormationSnapshot& s, FormationStatus& statu
     status.closest_foreign_agents = {"agent_" + std::to_string(foreign.agent), foreign.foreign};
   }
   const bool wasBlocked = safety_->blocked();
-  const bool blocked = safety_->observe(s.metrics.step, s.positions, s.metrics.maxDistanceError, s.converged);
+  const bool blocked = safety_->observe(s.metrics.step, s.positions, s.metrics.maxDistanceError, s.congruent);
   status.min_separation = safety_->minSeparation();
   status.constraints_active = static_cast<uint32_t>(safety_->constraintsActive());
   if (status.min_separation < scenario_.safety->radius) {

@@ -1,6 +1,6 @@
 // The run's shape as the monitor reports it (MonitorNode, monitor_node.hpp): the findings of the
 // newest completed step, and at the end the verdict `simulate` gives too (core shapeOutcome):
-// the desired shape, another shape with every edge right, or not converged.
+// the desired shape, its mirror image, folded, still settling, or not converged.
 #include <cmath>
 
 #include "variational_formation/ros/monitor_node.hpp"
@@ -19,7 +19,7 @@ ShapeOutcome MonitorNode::agentsVerdict() const {
   if (std::isnan(f.shapeError) && lastPositions_.size() > 0) {
     f.shapeError = measure().formation().shapeError(lastPositions_, lastScale_);
   }
-  const ShapeOutcome o = shapeOutcome(f, convergedStep_, scenario_.mirrorAllowed, scenario_.timeStep);
+  const ShapeOutcome o = shapeOutcome(f, congruentSince_, scenario_.mirrorAllowed, scenario_.timeStep);
   const std::string blocked = blockedBy();
   return blocked.empty() ? o : blockedShapeOutcome(o, blocked);
 }

@@ -11,6 +11,7 @@
 #include "variational_formation_core/model/shape_outcome.hpp"
 #include "variational_formation_core/manoeuvres/commanded_frame.hpp"
 #include "variational_formation_core/agents/run_tracker.hpp"
+#include "variational_formation_core/agents/run_verdict.hpp"
 #include "variational_formation_core/integrators/step_metrics.hpp"
 #include "variational_formation/tools/arguments.hpp"
 #include "variational_formation/tools/scenario_path.hpp"
@@ -28,17 +29,16 @@ const char* kUsage =
     "Runs a formation scenario centrally. traj.csv: step,t,agent,x,y,z;\n"
     "metrics.csv: step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error,\n"
     "shape_error (and min_separation under a scenario's safety: filter). The last line on stdout says\n"
-    "how the formation ended: 'formation: converged to the desired shape ...', 'formation: edges\n"
-    "converged but the shape is not the desired one ...' or 'formation: not converged ...'; with\n"
-    "`assignment: auto` a line 'assignment: ...' comes first, and with safety: a line 'simulate:\n"
-    "formation ...' before the last gives the closest approach and whether the run was blocked.\n"
+    "how the formation ended: 'formation: converged to the desired shape ...' or 'formation: not\n"
+    "converged' with why: its mirror image, folded, still settling at the last step, its final\n"
+    "max distance error, or blocked; with `assignment: auto` a line 'assignment: ...' comes first,\n"
+    "and with safety: a line 'simulate: safety: ...' before the last gives the closest approach.\n"
     "--commands: rows step,vx,vy,vz,wx,wy,wz,scale, each applying from its step on\n"
     "(doc/manoeuvres.md).\n"
     "Flags override the scenario file. --delay-steps D: each agent uses its neighbours'\n"
     "q_j^{k-D}; --loss P: each neighbour state is lost with probability P (seed S, default 1).\n"
-    "Exit status 2 on bad input, 1 if the run diverges, if a run under safety: is blocked or misses\n"
-    "a required convergence, or if the scenario has require_convergence: true and the formation\n"
-    "did not reach the desired shape.\n";
+    "Exit status 2 on bad input, 1 if the run diverges, or if the scenario has\n"
+    "require_convergence: true and the formation did not converge (blocked runs included).\n";
 
 std::ofstream openOutput(const std::string& flag, const std::string& path) {
   std::ofstream out(path);
@@ -71,23 +71,15 @@ bool parseDelayFlags(const Arguments& args, Method method, DelaySettings& delay)
   return true;
 }
 
-/// The last line of a tracked run, and its exit status (finishedRunVerdict).
-int reportOutcome(const RunTracker& tracker, const Scenario& scenario, std::ostream& out, std::ostream& err) {
-  const FormationOutcome formation = tracker.outcome();
-  out << "simulate: formation " << formation.line;
-  if (scenario.safety) {
-    const ClosestPair& c = tracker.closestApproach();
-    char distance[32];
-    std::snprintf(distance, sizeof distance, "%.4g", c.distance);
-    out << "; closest approach " << distance << " m";
-    if (c.first >= 0) out << " (agents " << c.first << ", " << c.second << " at step " << tracker.closestApproachStep() << ")";
-    out << "; filter active in " << tracker.filterActiveSteps() << " steps";
-  }
-  out << '\n';
-  const RunVerdict verdict = finishedRunVerdict(scenario, formation);
-  if (verdict.succeeded) return kExitOk;
-  err << "simulate: error: " << verdict.reason << '\n';
-  return kExitFailure;
+/// The safety filter's line of a tracked run: the closest approach and how often the filter bound
+/// (the shape's verdict, blocked or not, is the last line's alone).
+void reportSafety(const RunTracker& tracker, std::ostream& out) {
+  const ClosestPair& c = tracker.closestApproach();
+  char distance[32];
+  std::snprintf(distance, sizeof distance, "%.4g", c.distance);
+  out << "simulate: safety: closest approach " << distance << " m";
+  if (c.first >= 0) out << " (agents " << c.first << ", " << c.second << " at step " << tracker.closestApproachStep() << ")";
+  out << "; filter active in " << tracker.filterActiveSteps() << " steps\n";
 }
 
 }  // namespace
@@ -177,10 +169,12 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
           << " (try a smaller --time-step)\n";
       return kExitFailure;
     }
-    const int safetyStatus = tracker ? reportOutcome(*tracker, scenario, out, err) : kExitOk;
-    const ShapeOutcome outcome = shape.outcome(scenario.timeStep);
+    if (tracker) reportSafety(*tracker, out);
+    // One verdict: the shape's, or blocked; the exit status follows from it alone.
+    const std::string blocked = tracker ? tracker->blockedBy() : std::string();
+    const ShapeOutcome shaped = shape.outcome(scenario.timeStep);
+    const ShapeOutcome outcome = blocked.empty() ? shaped : blockedShapeOutcome(shaped, blocked);
     out << "formation: " << outcome.line << '\n';
-    if (safetyStatus != kExitOk) return safetyStatus;
     const RunVerdict verdict = finishedRunVerdict(scenario, outcome);
     if (verdict.succeeded) return kExitOk;
     err << "simulate: error: " << verdict.reason << '\n';

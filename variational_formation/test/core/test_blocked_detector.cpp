@@ -7,6 +7,8 @@
 
 #include "variational_formation_core/agents/blocked_detector.hpp"
 #include "variational_formation_core/agents/run_tracker.hpp"
+#include "variational_formation_core/agents/run_verdict.hpp"
+#include "variational_formation_core/model/shape_outcome.hpp"
 #include "variational_formation_core/safety/safety_stage.hpp"
 #include "variational_formation_core/integrators/step_metrics.hpp"
 
@@ -55,10 +57,18 @@ TEST(RunTracker, EndsABlockedRunNamingTheAgentsThatBlockEachOther) {
   EXPECT_TRUE(tracker.blocked());
   EXPECT_LT(last, s.steps);  // it stopped instead of running on
   EXPECT_GT(last, 100);      // blocked_after = 2 s = 100 steps at least
-  const FormationOutcome outcome = tracker.outcome();
-  EXPECT_FALSE(outcome.converged);
+  EXPECT_EQ(tracker.blockedBy(), "blocked: agents 1, 2");
+  // The run's verdict is the shape's, blocked (simulate's last line).
+  const Formation formation = makeFormation(s);
+  ShapeTracker shape(formation, s.mirrorAllowed);
+  runCentralised(s, Method::Variational, StartMethod::Variational, nullptr, [&](const Integrator& integrator) {
+    shape.observe(integrator.stepIndex(), integrator.positions(), integrator.velocities(), 1.0);
+    return integrator.stepIndex() < last;
+  });
+  const ShapeOutcome outcome = blockedShapeOutcome(shape.outcome(s.timeStep), tracker.blockedBy());
+  EXPECT_EQ(outcome.verdict, ShapeVerdict::NotConverged);
   EXPECT_EQ(outcome.line, "not converged (blocked: agents 1, 2)");
-  EXPECT_GT(outcome.finalError, 0.5);
+  EXPECT_GT(outcome.findings.maxEdgeError, 0.5);
   EXPECT_GE(closest, 0.25);
   EXPECT_EQ(tracker.closestApproach().distance, closest);
   EXPECT_EQ(tracker.closestApproach().first, 1);

@@ -46,12 +46,24 @@ TEST(FormationMonitor, EachCongruentStretchSaysWhetherItIsTheMirrorImage) {
   long k = 1;
   for (const auto& [q, mirrored] : run) {
     const FormationSnapshot snap = measureAt(monitor, k, *q, *q);
-    EXPECT_EQ(snap.converged, q != &stretched) << "step " << k;
+    EXPECT_EQ(snap.congruent, q != &stretched) << "step " << k;
     EXPECT_EQ(snap.shape.mirrored, mirrored) << "step " << k;
-    const ShapeFindings alone = findShape(f, *q, Positions::Zero(2, 6), 1.0, snap.converged, 0.01, 0.1);  // the defaults
+    // Converged means the desired shape (issue 50): the mirror image is congruent, not converged.
+    EXPECT_EQ(snap.converged, q == &desired) << "step " << k;
+    EXPECT_EQ(snap.congruentSince, q == &stretched ? -1 : q == &mirror ? 1 : 5) << "step " << k;
+    EXPECT_EQ(snap.convergedStep, q == &desired ? 5 : -1) << "step " << k;
+    const ShapeFindings alone = findShape(f, *q, Positions::Zero(2, 6), 1.0, snap.congruent, 0.01, 0.1);  // the defaults
     EXPECT_EQ(snap.shape.mirrored, alone.mirrored) << "step " << k;
     ++k;
   }
+  // With `mirror: allowed` the mirror image is the desired shape too.
+  Scenario either = s;
+  either.mirrorAllowed = true;
+  FormationMonitor lenient(either);
+  lenient.startAt(1, -1);
+  const FormationSnapshot allowed = measureAt(lenient, 1, mirror, mirror);
+  EXPECT_TRUE(allowed.converged && allowed.shape.mirrored);
+  EXPECT_EQ(allowed.convergedStep, 1);
   // A monitor restarted inside a congruent stretch tests it again.
   FormationMonitor restarted(s);
   restarted.startAt(k, 5);

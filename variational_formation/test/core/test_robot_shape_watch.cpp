@@ -87,7 +87,7 @@ TEST(RobotShapeWatch, OneRobotFiveCentimetresOffIsNotInShapeWithItsErrors) {
   const RobotShapeStep& r = w.observe(40, 10.0, 1.0);
   ASSERT_TRUE(r.measured);
   EXPECT_FALSE(r.findings.congruent);
-  EXPECT_FALSE(r.findings.edgesConverged);
+  EXPECT_FALSE(r.findings.edgesWithin);
   EXPECT_NEAR(r.findings.maxEdgeError, 0.05, 1e-12);
   EXPECT_NEAR(r.findings.shapeError, 0.05, 1e-12);
   EXPECT_EQ(r.inShapeSince, -1);
@@ -208,7 +208,7 @@ TEST(RobotShapeWatch, BadOdometryAndSettingsAreRefusedInOneLine) {
 
 TEST(RobotModeOutcome, TheLaterOfTheTwoOrTheRobotsWhenTheyAreWorse) {
   ShapeFindings good;
-  good.congruent = good.edgesConverged = true;
+  good.congruent = good.edgesWithin = good.atRest = true;
   const ShapeOutcome agents = shapeOutcome(good, 100, false, 0.01);
   ShapeOutcome robots = shapeOutcome(good, 150, false, 0.01);
   ShapeOutcome o = robotModeOutcome(agents, robots, 0.01);
@@ -233,6 +233,35 @@ TEST(RobotModeOutcome, TheLaterOfTheTwoOrTheRobotsWhenTheyAreWorse) {
   const RunVerdict v = finishedRunVerdict(parseScenario(hexagonYaml(true), "hex.yaml"), o);
   EXPECT_FALSE(v.succeeded);
   EXPECT_NE(v.reason.find("final max distance error 0.05 m"), std::string::npos) << v.reason;
+
+  // The robots with every edge right but not every pair while the agents are in the desired shape:
+  // they have not caught up (their speeds are not measured), still settling, not folded; with the
+  // agents folded too, folded. Robots in the mirror image say so.
+  RobotShapeWatch behind(hexagon(), RobotShapeSettings{});
+  Positions folded = moved(0.0, 0.0, 0.0);
+  folded.col(1) << 0.0, 0.0;  // agent 1 (linked to 0 and 2 only) reflected through the chord 0-2
+  feedAll(behind, 0.0, folded);
+  behind.observe(3, 0.0, 1.0);
+  const ShapeOutcome robotsFolded = behind.outcome(0.01);
+  EXPECT_EQ(robotsFolded.verdict, ShapeVerdict::Folded);
+  EXPECT_EQ(robotsFolded.line, "not converged: folded (the robots, from odometry: every edge within tolerance but not "
+                               "every pair; shape error 1 m)");
+  o = robotModeOutcome(agents, robotsFolded, 0.01);
+  EXPECT_EQ(o.verdict, ShapeVerdict::StillSettling);
+  EXPECT_EQ(o.line, "not converged: still settling at the last step (the robots, from odometry, behind the agents, "
+                    "which are in the desired shape: shape error 1 m)");
+  ShapeFindings foldedAgents;
+  foldedAgents.edgesWithin = foldedAgents.atRest = true;
+  EXPECT_EQ(robotModeOutcome(shapeOutcome(foldedAgents, -1, false, 0.01), robotsFolded, 0.01).verdict,
+            ShapeVerdict::Folded);
+  RobotShapeWatch mirrored(hexagon(), RobotShapeSettings{});
+  Positions mirror = moved(0.0, 0.0, 0.0);
+  mirror.row(1) *= -1.0;
+  feedAll(mirrored, 0.0, mirror);
+  mirrored.observe(5, 0.0, 1.0);
+  EXPECT_EQ(robotModeOutcome(agents, mirrored.outcome(0.01), 0.01).line,
+            "not converged: the mirror image of the desired shape (the robots, from odometry, from step 5; mirror: "
+            "forbidden)");
 
   // The agents not converged (blocked) decide, whatever the robots.
   const ShapeOutcome blocked = blockedShapeOutcome(agents, "blocked: agents 2, 4");

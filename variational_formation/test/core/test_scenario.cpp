@@ -11,7 +11,6 @@
 #include "test_support.hpp"
 #include "variational_formation_core/common/invalid_input.hpp"
 #include "variational_formation_core/common/number_checks.hpp"
-#include "variational_formation_core/agents/run_verdict.hpp"
 #include "variational_formation_core/model/validation.hpp"
 #include "variational_formation_core/integrators/variational_update.hpp"
 
@@ -137,28 +136,6 @@ TEST(Scenario, RequireConvergenceIsABoolean) {
   EXPECT_FALSE(parseScenario(replaced(valid(), "steps: 10", "steps: 10\nrequire_convergence: false"), "f").requireConvergence);
   expectError(replaced(valid(), "steps: 10", "steps: 10\nrequire_convergence: 1"), {"require_convergence: expected true or false"});
   expectError(replaced(valid(), "steps: 10", "steps: 10\nrequire_convergence: [true]"), {"require_convergence: expected true or false"});
-}
-
-TEST(RunOutcome, SaysWhetherAndWhenTheFormationConverged) {
-  const FormationOutcome yes = formationOutcome(210, 1e-6, 0.014);
-  EXPECT_TRUE(yes.converged);
-  EXPECT_EQ(yes.line, "converged at step 210 (t = 2.940 s)");
-  const FormationOutcome no = formationOutcome(-1, 0.8125, 0.01);
-  EXPECT_FALSE(no.converged);
-  EXPECT_EQ(no.line, "not converged (final max distance error 0.812 m)");
-}
-
-TEST(RunOutcome, ANotConvergedRunFailsOnlyIfTheScenarioRequiresConvergence) {
-  Scenario s = parseScenario(valid(), "file.yaml");
-  const FormationOutcome no = formationOutcome(-1, 0.5, s.timeStep);
-  EXPECT_TRUE(finishedRunVerdict(s, no).succeeded);
-  EXPECT_TRUE(finishedRunVerdict(s, formationOutcome(3, 0.0, s.timeStep)).succeeded);
-  s.requireConvergence = true;
-  const RunVerdict v = finishedRunVerdict(s, no);
-  EXPECT_FALSE(v.succeeded);
-  EXPECT_EQ(v.reason, "the formation did not converge (final max distance error 0.5 m), and the scenario "
-                      "requires it (require_convergence: true)");
-  EXPECT_TRUE(finishedRunVerdict(s, formationOutcome(3, 0.0, s.timeStep)).succeeded);
 }
 
 TEST(Scenario, EmptyAgents) { expectError(kHeader + "agents: []\n", {"agents", "non-empty"}); }

@@ -1,5 +1,6 @@
 // The tools of issue 32: scenario_info's rigidity lines, make_scenario --graph (globally rigid
-// graphs), assign_slots, and simulate's final line on the desired, a folded and an assigned run.
+// graphs), assign_slots, and simulate's final line on the desired, a folded and an assigned run;
+// issue 50: one verdict in every line of a run (mirror image, still settling, folded).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -143,12 +144,13 @@ TEST(Simulate, TheFinalLineTellsAFoldedShapeFromTheDesiredOne) {
   const std::string foldedPath = write("folded.yaml", folded);
   const CliResult other = run(runSimulateCli, {"--scenario", foldedPath, "--out", traj, "--steps", "20"});
   EXPECT_EQ(other.status, 0) << other.err;
-  EXPECT_EQ(other.out, "formation: edges converged but the shape is not the desired one (shape error 3 m)\n");
+  EXPECT_EQ(other.out, "formation: not converged: folded, at rest with every edge within tolerance but not every pair "
+                       "(shape error 3 m)\n");
   // With require_convergence: true it is a failure.
   const std::string required = write("required.yaml", folded + "require_convergence: true\n");
   const CliResult fails = run(runSimulateCli, {"--scenario", required, "--out", traj, "--steps", "20"});
   EXPECT_EQ(fails.status, 1);
-  EXPECT_EQ(lastLine(fails.err), "simulate: error: the formation did not reach the desired shape, and the scenario "
+  EXPECT_EQ(lastLine(fails.err), "simulate: error: the formation did not converge (folded), and the scenario "
                                  "requires it (require_convergence: true)");
   // assignment: auto on the hexagon's own starts keeps the numbering (each starts nearest its slot).
   const std::string assigned = write("assigned.yaml", text.str() + "assignment: auto\n");
@@ -196,6 +198,76 @@ TEST(AssignSlots, WritesTheScenarioWithTheRobotsStartsAndTheirSlots) {
   const std::string planar = write("planar.csv", "agent,x,y,z\n0,1,2,0.5\n");
   const CliResult p = run(runAssignSlotsCli, {"--scenario", kConfig + "hexagon.yaml", "--starts", planar});
   EXPECT_EQ(p.err, "assign_slots: error: " + planar + ": line 2: z: must be 0 in a 2D scenario, got 0.5\n");
+}
+
+// Issue 50, defect 4: a 12-agent scattered deployment (complete graph, safety filter) that ends as
+// the mirror image. No line says "converged" but "not converged", with or without
+// require_convergence; with `mirror: allowed` the same run converges, at the same step.
+TEST(Simulate, AMirrorImageIsNotConvergedInAnyLine) {
+  std::string comments;
+  generated({"--shape", "ring", "--agents", "12", "--chords", "5", "--scatter", "6", "--min-gap", "0.4", "--seed", "2",
+             "--safety", "0.25", "1", "0.2", "--time-step", "0.02", "--steps", "1500"},
+            "mirror12.yaml", &comments);
+  std::ifstream in(tempPath("mirror12.yaml"));
+  std::stringstream text;
+  text << in.rdbuf();
+  const auto lines = [](const std::string& out) {
+    std::vector<std::string> all;
+    std::istringstream s(out);
+    for (std::string line; std::getline(s, line);) all.push_back(line);
+    return all;
+  };
+  for (const bool required : {false, true}) {
+    const std::string path = write("mirror12_run.yaml", text.str() + (required ? "require_convergence: true\n" : ""));
+    const CliResult r = run(runSimulateCli, {"--scenario", path, "--out", "/dev/null"});
+    EXPECT_EQ(r.status, required ? 1 : 0) << r.err;
+    const std::vector<std::string> out = lines(r.out);
+    ASSERT_EQ(out.size(), 2u) << r.out;
+    EXPECT_EQ(out[0].rfind("simulate: safety: closest approach 0.2", 0), 0u) << r.out;
+    EXPECT_EQ(out[1], "formation: not converged: the mirror image of the desired shape from step 293 (t = 5.860 s; "
+                      "mirror: forbidden)");
+    for (const std::string& line : lines(r.out + r.err)) {
+      const std::size_t at = line.find("converged");
+      EXPECT_TRUE(at == std::string::npos || (at >= 4 && line.compare(at - 4, 4, "not ") == 0)) << line;
+    }
+    if (required) {
+      EXPECT_EQ(r.err, "simulate: error: the formation did not converge (its mirror image), and the scenario requires "
+                       "it (require_convergence: true)\n");
+    }
+  }
+  const std::string allowed = write("mirror12_allowed.yaml", text.str() + "mirror: allowed\n");
+  const CliResult a = run(runSimulateCli, {"--scenario", allowed, "--out", "/dev/null"});
+  EXPECT_EQ(a.status, 0) << a.err;
+  EXPECT_EQ(lastLine(a.out), "formation: converged to the desired shape at step 293 (t = 5.860 s), its mirror image "
+                             "(mirror: allowed)");
+}
+
+// Issue 50, defect 5: assign_slots keeps the hexagon's 300 steps; robots parked at these starts
+// are still moving at step 300 with every edge right (still settling, not folded) and converge at
+// step 332 with 3000 steps; robots parked at the second set of starts fold it for good.
+TEST(Simulate, AShortRunThatStillMovesIsStillSettlingNotFolded) {
+  const std::string near = write("near.csv", "agent,x,y,z\n0,3.361,-0.750,0\n1,1.198,3.939,0\n2,-1.053,2.853,0\n"
+                                             "3,-4.304,-1.343,0\n4,-2.366,-3.685,0\n5,2.951,-4.090,0\n");
+  const std::string inside = write("inside.csv", "agent,x,y,z\n0,4.184,-0.232,0\n1,1.769,1.172,0\n2,-0.980,3.855,0\n"
+                                                 "3,-2.020,1.157,0\n4,-1.019,-3.361,0\n5,2.306,-3.463,0\n");
+  const auto assigned = [&](const std::string& starts, const std::string& name) {
+    const std::string out = tempPath(name);
+    const CliResult r = run(runAssignSlotsCli, {"--scenario", kConfig + "hexagon.yaml", "--starts", starts, "--out", out});
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(loadScenario(out).steps, 300);
+    return out;
+  };
+  const std::string settling = assigned(near, "near.yaml");
+  CliResult r = run(runSimulateCli, {"--scenario", settling, "--out", "/dev/null"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("formation: not converged: still settling at the last step (every edge within tolerance; "
+                        "shape error 0.0706 m; fastest agent 0.0", 0), 0u)
+      << r.out;
+  r = run(runSimulateCli, {"--scenario", settling, "--out", "/dev/null", "--steps", "3000"});
+  EXPECT_EQ(r.out, "formation: converged to the desired shape at step 332 (t = 4.648 s)\n");
+  r = run(runSimulateCli, {"--scenario", assigned(inside, "inside.yaml"), "--out", "/dev/null", "--steps", "3000"});
+  EXPECT_EQ(r.out, "formation: not converged: folded, at rest with every edge within tolerance but not every pair "
+                   "(shape error 3 m)\n");
 }
 
 }  // namespace

@@ -118,21 +118,24 @@ FormationSnapshot FormationMonitor::measureStep(long step, const Positions& qPre
   s.scale = scale;
   s.positions = q;
   subtractCommandedMotion(command, q, v);  // from here on, relative to the commanded motion
-  s.converged = congruence_.check(formation_, q, v, scale);
+  s.congruent = congruence_.check(formation_, q, v, scale);
   // The O(n^2) shape error at most a 50-agent cost per step (NaN between).
   const bool measured = shapeErrorMeasuredAt(step, formation_.agentCount(), scenario_.steps);
   // The mirror test once per congruent stretch: its answer holds while the shape stays congruent.
-  const bool mirrorKnown = s.converged && congruentSince_ >= 0 && mirrorTested_;
-  s.shape = findShape(formation_, q, v, scale, s.converged, tolerance_, maxSpeed_, measured,
-                      mirrorKnown ? &mirrored_ : nullptr);
-  mirrorTested_ = s.converged;
+  const bool mirrorKnown = s.congruent && congruentSince_ >= 0 && mirrorTested_;
+  s.shape = findShape(formation_, q, v, scale, s.congruent, tolerance_, maxSpeed_, measured,
+                      mirrorKnown ? &mirrored_ : nullptr, static_cast<double>(step) * h);
+  mirrorTested_ = s.congruent;
   mirrored_ = s.shape.mirrored;
-  if (!s.converged) {
+  if (!s.congruent) {
     congruentSince_ = -1;
   } else if (congruentSince_ < 0) {
     congruentSince_ = step;
   }
-  s.convergedStep = congruentSince_;
+  // A congruent stretch keeps its hand (findShape): converged from its first step, or never.
+  s.congruentSince = congruentSince_;
+  s.converged = s.congruent && (!s.shape.mirrored || scenario_.mirrorAllowed);
+  s.convergedStep = s.converged ? congruentSince_ : -1;
   return s;
 }
 

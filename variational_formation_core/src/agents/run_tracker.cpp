@@ -40,11 +40,6 @@ bool RunTracker::observe(const Integrator& integrator) {
     if (!schedule_.empty()) subtractCommandedMotion(schedule_.at(step > 0 ? step - 1 : 0), q, v);
     congruent = congruence_.check(formation, q, v, scale);
   }
-  if (!congruent) {
-    convergedStep_ = -1;
-  } else if (convergedStep_ < 0) {
-    convergedStep_ = step;
-  }
   SafetyStage* safety = integrator.safety();
   if (!safety) return true;
   const ClosestPair pair = safety->closestPair(q, step);
@@ -57,11 +52,6 @@ bool RunTracker::observe(const Integrator& integrator) {
   if (stepped && !safety->bindingAgents().empty()) ++filterActiveSteps_;
   return !blocked_.update(step, lastError_, congruent, stepped ? safety->bindingAgents() : kNone,
                           stepped ? safety->bindingObstacles() : kNone);
-}
-
-FormationOutcome RunTracker::outcome() const {
-  if (blocked_.blocked()) return blockedOutcome(blocked_.description(), lastError_);
-  return formationOutcome(convergedStep_, lastError_, scenario_.timeStep);
 }
 
 }  // namespace vf

@@ -4,56 +4,31 @@
 
 namespace vf {
 
-FormationOutcome formationOutcome(long convergedStep, double finalError, double timeStep) {
-  FormationOutcome o;
-  char text[160];
-  o.converged = convergedStep >= 0;
-  o.finalError = finalError;
-  if (o.converged) {
-    std::snprintf(text, sizeof text, "converged at step %ld (t = %.3f s)", convergedStep, convergedStep * timeStep);
-  } else {
-    std::snprintf(text, sizeof text, "not converged (final max distance error %.3g m)", finalError);
+namespace {
+
+/// Why the shape is not the desired one, in a few words.
+std::string shortfall(const ShapeOutcome& shape) {
+  if (!shape.blocked.empty()) return shape.blocked;
+  char text[80];
+  switch (shape.verdict) {
+    case ShapeVerdict::MirrorImage: return "its mirror image";
+    case ShapeVerdict::Folded: return "folded";
+    case ShapeVerdict::StillSettling: return "still settling at the last step";
+    case ShapeVerdict::DesiredShape:
+    case ShapeVerdict::NotConverged: break;
   }
-  o.line = text;
-  return o;
+  std::snprintf(text, sizeof text, "final max distance error %.3g m", shape.findings.maxEdgeError);
+  return text;
 }
 
-FormationOutcome blockedOutcome(const std::string& blocked, double finalError) {
-  FormationOutcome o;
-  o.finalError = finalError;
-  o.blocked = blocked;
-  o.line = "not converged (" + blocked + ")";
-  return o;
-}
-
-RunVerdict finishedRunVerdict(const Scenario& scenario, const FormationOutcome& formation) {
-  RunVerdict v;
-  if (scenario.requireConvergence && !formation.converged) {
-    v.succeeded = false;
-    if (!formation.blocked.empty()) {
-      v.reason = "the formation did not converge (" + formation.blocked +
-                 "), and the scenario requires it (require_convergence: true)";
-      return v;
-    }
-    char text[200];
-    std::snprintf(text, sizeof text,
-                  "the formation did not converge (final max distance error %.3g m), and the scenario requires it "
-                  "(require_convergence: true)",
-                  formation.finalError);
-    v.reason = text;
-  }
-  return v;
-}
+}  // namespace
 
 RunVerdict finishedRunVerdict(const Scenario& scenario, const ShapeOutcome& shape) {
-  if (shape.verdict == ShapeVerdict::NotConverged) {
-    if (!shape.blocked.empty()) return finishedRunVerdict(scenario, blockedOutcome(shape.blocked, shape.findings.maxEdgeError));
-    return finishedRunVerdict(scenario, formationOutcome(-1, shape.findings.maxEdgeError, scenario.timeStep));
-  }
   RunVerdict v;
   if (scenario.requireConvergence && shape.verdict != ShapeVerdict::DesiredShape) {
     v.succeeded = false;
-    v.reason = "the formation did not reach the desired shape, and the scenario requires it (require_convergence: true)";
+    v.reason = "the formation did not converge (" + shortfall(shape) +
+               "), and the scenario requires it (require_convergence: true)";
   }
   return v;
 }

@@ -19,9 +19,9 @@ std::string robotList(const std::vector<int>& ids) {
   return out;
 }
 
-// The verdict's order: a worse one decides a robot-mode run.
+// The verdict's order: a worse one decides a robot-mode run (the shapes with every edge right tie).
 int rank(ShapeVerdict v) {
-  return v == ShapeVerdict::DesiredShape ? 2 : v == ShapeVerdict::OtherShape ? 1 : 0;
+  return v == ShapeVerdict::DesiredShape ? 2 : v == ShapeVerdict::NotConverged ? 0 : 1;
 }
 
 }  // namespace
@@ -87,7 +87,8 @@ std::vector<int> RobotShapeWatch::silent(double now) const {
 const RobotShapeStep& RobotShapeWatch::observe(long step, double now, double scale) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   RobotShapeStep& r = last_;
-  r.findings = ShapeFindings{nan, nan, false, false, false};
+  r.findings = ShapeFindings{};
+  r.findings.shapeError = r.findings.maxEdgeError = nan;
   const std::vector<int> never = unheard(), quiet = silent(now);
   r.measured = never.empty() && quiet.empty();
   r.unmeasured.clear();
@@ -134,21 +135,44 @@ ShapeOutcome RobotShapeWatch::outcome(double timeStep) const {
   if (std::isnan(f.shapeError)) f.shapeError = formation_.shapeError(points_, scale_);  // skipped at this step
   ShapeOutcome o = shapeOutcome(f, last_.inShapeSince, mirrorAllowed_, timeStep);
   char text[200];
-  if (o.verdict == ShapeVerdict::OtherShape) {
-    std::snprintf(text, sizeof text,
-                  "edges converged but the shape is not the desired one (the robots, from odometry: %sshape error %.3g m)",
-                  f.mirrored ? "its mirror image; " : "", f.shapeError);
-    o.line = text;
-  } else if (o.verdict == ShapeVerdict::NotConverged) {
-    std::snprintf(text, sizeof text,
-                  "not converged (the robots, from odometry: max distance error %.3g m, shape error %.3g m)",
-                  f.maxEdgeError, f.shapeError);
-    o.line = text;
+  // Their velocities are taken as zero (at rest): a robots' shape with every edge right is folded or mirrored.
+  switch (o.verdict) {
+    case ShapeVerdict::MirrorImage:
+      std::snprintf(text, sizeof text,
+                    "not converged: the mirror image of the desired shape (the robots, from odometry, from step %ld; "
+                    "mirror: forbidden)", last_.inShapeSince);
+      break;
+    case ShapeVerdict::Folded:
+      std::snprintf(text, sizeof text, "not converged: folded (the robots, from odometry: every edge within tolerance "
+                    "but not every pair; shape error %.3g m)", f.shapeError);
+      break;
+    case ShapeVerdict::NotConverged:
+      std::snprintf(text, sizeof text,
+                    "not converged (the robots, from odometry: max distance error %.3g m, shape error %.3g m)",
+                    f.maxEdgeError, f.shapeError);
+      break;
+    case ShapeVerdict::DesiredShape:
+    case ShapeVerdict::StillSettling:
+      return o;
   }
+  o.line = text;
   return o;
 }
 
 ShapeOutcome robotModeOutcome(const ShapeOutcome& agents, const ShapeOutcome& robots, double timeStep) {
+  if (robots.verdict == ShapeVerdict::Folded && agents.verdict == ShapeVerdict::DesiredShape) {
+    // The robots follow the agents, which are in shape: robots with every edge right but not every
+    // pair have not caught up yet (their speeds are not measured), they are not folded.
+    ShapeOutcome o = robots;
+    o.verdict = ShapeVerdict::StillSettling;
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "not converged: still settling at the last step (the robots, from odometry, behind the agents, "
+                  "which are in the desired shape: shape error %.3g m)",
+                  robots.findings.shapeError);
+    o.line = text;
+    return o;
+  }
   if (rank(robots.verdict) < rank(agents.verdict)) return robots;
   if (agents.verdict != ShapeVerdict::DesiredShape) return agents;
   // Both in the desired shape: the run converged when the later of the two did.

@@ -188,7 +188,7 @@ class MonitorNode {
   long dropped_ = 0;
   ros::WallTime firstStepAt_, lastCompletedAt_, lastReportAt_, startedAt_;
   long reportedConvergence_ = -2;  // the congruent stretch already announced (-2: none)
-  long convergedStep_ = -1;        // first step of the congruent stretch at the newest step (-1: none)
+  long congruentSince_ = -1;       // first step of the congruent stretch (either hand) at the newest step (-1: none)
   long commandsRefused_ = 0;  // live commands refused, for the result file
   std::unique_ptr<protocol::CommandDesk> desk_;
   ros::NodeHandle pnh_;

@@ -21,8 +21,12 @@ struct FormationSnapshot {
   Eigen::VectorXd edgeDistanceErrors;   ///< |q_i - q_j| - s d_ij per edge
   double scale = 1.0;                  ///< s, the commanded scale the step is measured against
   Positions positions;                 ///< q_k, d x n
-  bool converged = false;              ///< congruent (with s d_ij, moving as commanded) at this step
-  long convergedStep = -1;             ///< first step of the current congruent stretch
+  bool congruent = false;              ///< every pair within 1% of s d_ij and every agent slow (moving as commanded), either hand
+  long congruentSince = -1;            ///< first step of the current congruent stretch, -1 if not congruent
+  /// In the desired shape at this step: congruent, and not a mirror image that the scenario
+  /// forbids (`mirror: forbidden`, the default). The one meaning of "converged" (ShapeOutcome).
+  bool converged = false;
+  long convergedStep = -1;             ///< first step of the current converged stretch, -1 if not converged
   /// Shape error over all pairs, edges converged, mirror image (shape_outcome.hpp). The O(n^2)
   /// shape error is measured when shapeErrorMeasuredAt says (every step up to 50 agents, beyond
   /// that every ceil((n/50)^2) steps and at the last one; NaN between). The mirror test runs at
@@ -52,8 +56,9 @@ class FormationMonitor {
               long lastAllowed);
   /**
    * Starts at `step` instead of 0 (a restarted monitor): the steps before it count as completed,
-   * and `congruentSince` is the first step of the congruent stretch holding at step - 1 (-1 if
-   * none). Requires that nothing was added yet.
+   * and `congruentSince` is the first step of the converged stretch holding at step - 1 (-1 if
+   * none: a stretch in a forbidden mirror image is not carried over, and starts again at `step`).
+   * Requires that nothing was added yet.
    */
   void startAt(long step, long congruentSince);
   /// Agents whose state at `step` has not arrived (all of them if none has).

@@ -4,17 +4,16 @@
 #include "variational_formation_core/model/formation.hpp"
 #include "variational_formation_core/integrators/integrator.hpp"
 #include "variational_formation_core/manoeuvres/command_schedule.hpp"
-#include "variational_formation_core/agents/run_verdict.hpp"
 #include "variational_formation_core/model/scenario.hpp"
 #include "variational_formation_core/model/spatial_grid.hpp"
 
 namespace vf {
 
 /**
- * The outcome of a centralised run, judged step by step as the monitor judges a distributed one:
- * congruence with the desired shape (1% on every pair, speeds below 0.1 m/s relative to the
- * commanded motion), and under a safety filter the closest approach, the steps the filter bound
- * and whether the formation is blocked (BlockedDetector).
+ * A centralised run under a safety filter, judged step by step as the monitor judges a
+ * distributed one: the closest approach, the steps the filter bound and whether the formation is
+ * blocked (BlockedDetector, which needs congruence with the desired shape: 1% on every pair,
+ * speeds below 0.1 m/s relative to the commanded motion). The shape's verdict is ShapeTracker's.
  */
 class RunTracker {
  public:
@@ -24,11 +23,8 @@ class RunTracker {
   /// Step k of the run, in order. @return false once the run is blocked (it should stop there).
   bool observe(const Integrator& integrator);
 
-  /// "converged at step K (t = T s)", "not converged (final max distance error E m)" or
-  /// "not converged (blocked: agents 2, 4)", of the last observed step.
-  FormationOutcome outcome() const;
-  /// First step of the congruent stretch that holds at the last observed step (-1: none).
-  long convergedStep() const { return convergedStep_; }
+  /// "blocked: agents 2, 4" (BlockedDetector::description()) once the run is blocked, else empty.
+  std::string blockedBy() const { return blocked_.blocked() ? blocked_.description() : std::string(); }
   /// The closest pair over every observed step (distance +inf without a safety filter).
   const ClosestPair& closestApproach() const { return closest_; }
   long closestApproachStep() const { return closestStep_; }
@@ -41,7 +37,6 @@ class RunTracker {
   const CommandSchedule& schedule_;
   CongruenceTracker congruence_;
   BlockedDetector blocked_;
-  long convergedStep_ = -1;
   double lastError_ = 0.0;
   ClosestPair closest_;
   long closestStep_ = -1;

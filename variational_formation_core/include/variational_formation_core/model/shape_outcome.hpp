@@ -10,10 +10,24 @@ namespace vf {
 struct ShapeFindings {
   double shapeError = 0.0;     ///< Formation::shapeError, over all pairs [m]
   double maxEdgeError = 0.0;   ///< Formation::maxDistanceError, over the edges [m]
+  double fastestSpeed = 0.0;   ///< the fastest agent's speed relative to the commanded motion [m/s]
   bool congruent = false;      ///< every pair within tolerance, every agent slow (as given)
-  bool edgesConverged = false; ///< every edge within tolerance, every agent slow
+  bool edgesWithin = false;    ///< every edge within tolerance, at any speed
+  /// Every agent slower than restSpeed(maxSpeed), and no pair's distance error falling fast enough
+  /// to come within tolerance in another `horizon` (findShape).
+  bool atRest = false;
   bool mirrored = false;       ///< congruent, and with the mirror image of the desired shape (isMirrorImage)
 };
+
+/**
+ * Below this speed [m/s] an agent is at rest: a hundredth of the congruence's speed limit
+ * `maxSpeed` (0.001 m/s with the monitor's 0.1). A formation with every edge within tolerance
+ * whose agents are not all at rest is still settling, not folded. Measured: at step 300 of the
+ * hexagon from 30 scattered starts the runs still settling move at 0.021 to 0.032 m/s; the 67
+ * folds of benchmark/deployments.py (1500 steps) below 0.00078 m/s, and the hexagon's folds
+ * after 3000 steps below 1.2e-9 m/s.
+ */
+inline double restSpeed(double maxSpeed) { return 0.01 * maxSpeed; }
 
 /**
  * The findings at one configuration q [m] with velocities v relative to the commanded motion
@@ -24,10 +38,15 @@ struct ShapeFindings {
  * @param knownMirror the mirror test's answer at an earlier step of the same congruent stretch,
  *        taken as it is (a congruent shape cannot change hands without passing through a flat
  *        one, which is not congruent); nullptr: test it. Ignored when not congruent.
+ * @param horizon [s] a formation with every edge within tolerance, not congruent and every agent
+ *        slow is still not at rest while some pair outside tolerance closes fast enough to come
+ *        within it in this long at its current rate, d|e_ij|/dt = sign(e_ij) (q_i - q_j).(v_i - v_j)
+ *        / |q_i - q_j| (the run's own duration t_k: a distance error still falling). O(n^2), on
+ *        such a formation only, with withShapeError. 0: speeds alone.
  */
 ShapeFindings findShape(const Formation& formation, const Positions& q, const Velocities& v, double scale,
                         bool congruent, double tolerance, double maxSpeed, bool withShapeError = true,
-                        const bool* knownMirror = nullptr);
+                        const bool* knownMirror = nullptr, double horizon = 0.0);
 
 /**
  * Whether a run measures the O(n^2) shape error at `step`: at most a 50-agent cost per step on
@@ -37,8 +56,13 @@ ShapeFindings findShape(const Formation& formation, const Positions& q, const Ve
  */
 bool shapeErrorMeasuredAt(long step, int agents, long lastStep);
 
-/// The three endings of a run.
-enum class ShapeVerdict { DesiredShape, OtherShape, NotConverged };
+/**
+ * The endings of a run: the desired shape (converged); its mirror image (every pair right, but
+ * left and right swapped, with `mirror: forbidden`); folded (every edge within tolerance, not
+ * every pair, at rest); still settling (every edge within tolerance, not in shape, still moving
+ * at the last step); not converged (some edge off, or blocked). Only the first is "converged".
+ */
+enum class ShapeVerdict { DesiredShape, MirrorImage, Folded, StillSettling, NotConverged };
 
 struct ShapeOutcome {
   ShapeVerdict verdict = ShapeVerdict::NotConverged;
@@ -47,12 +71,17 @@ struct ShapeOutcome {
   /// Why the run stopped short of the shape under a safety filter ("blocked: agents 2, 4",
   /// BlockedDetector::description()), or empty; set by blockedShapeOutcome.
   std::string blocked;
-  /// "converged to the desired shape at step K (t = T s)",
-  /// "edges converged but the shape is not the desired one (shape error E m)" (with "its mirror
-  /// image; " before the shape error for a mirror image), or
-  /// "not converged (final max distance error E m)".
+  /// "converged to the desired shape at step K (t = T s)", and otherwise a line starting "not
+  /// converged": ": the mirror image of the desired shape from step K (t = T s; mirror:
+  /// forbidden)", ": folded, at rest with every edge within tolerance but not every pair (shape
+  /// error E m)", ": still settling at the last step (every edge within tolerance; shape error E m;
+  /// fastest agent V m/s)" or " (final max distance error E m)".
   std::string line;
 };
+
+/// The result file's `verdict:` value: desired_shape, mirror_image, folded, still_settling or
+/// not_converged, and blocked for a blockedShapeOutcome.
+std::string verdictName(const ShapeOutcome& outcome);
 
 /// The outcome of a run that the safety filter blocked: not converged, with line
 /// "not converged (blocked: agents 2, 4)"; the findings are kept.
@@ -60,7 +89,8 @@ ShapeOutcome blockedShapeOutcome(ShapeOutcome outcome, const std::string& blocke
 
 /**
  * The verdict at the last step: the desired shape if congruent and not mirrored (or mirrored
- * with mirrorAllowed); another shape if every edge converged; else not converged.
+ * with mirrorAllowed); the mirror image if congruent and mirrored without it; with every edge
+ * within tolerance, folded if at rest and still settling if not; else not converged.
  * @param congruentSince first step of the congruent stretch holding at the last step (-1 if
  * none); @param timeStep h [s].
  */
@@ -77,12 +107,15 @@ class ShapeTracker {
   void observe(long step, const Positions& q, const Velocities& v, double scale);
   /// The outcome at the last observed step. @param timeStep h [s].
   ShapeOutcome outcome(double timeStep) const;
+  /// First step of the congruent stretch (either hand) holding at the last observed step, -1 if none.
+  long congruentSince() const { return congruentSince_; }
 
  private:
   const Formation& formation_;
   bool mirrorAllowed_;
   double tolerance_, maxSpeed_;
   CongruenceTracker congruence_;
+  long step_ = 0;
   long congruentSince_ = -1;
   bool congruent_ = false;
   Positions q_;

@@ -68,8 +68,9 @@ class RobotShapeWatch {
 
   /**
    * The robots' own verdict at the last observed step, as shapeOutcome gives the agents'
-   * (desired shape, another shape with every edge right, or not converged; a run in which some
-   * robot was never measured is not converged). @param timeStep h [s].
+   * (desired shape; with every edge right, the mirror image or folded, since the robots'
+   * velocities are not measured; or not converged; a run in which some robot was never measured
+   * is not converged). @param timeStep h [s].
    */
   ShapeOutcome outcome(double timeStep) const;
 
@@ -88,8 +89,10 @@ class RobotShapeWatch {
 
 /**
  * The verdict of a robot-mode run (doc/robots.md, "Converged means the robots"): the worse of the
- * agents' and the robots' verdicts (not converged < another shape < the desired shape). Both in
- * the desired shape: converged at the later of the two steps. The robots worse: their verdict, in
+ * agents' and the robots' verdicts (not converged < a shape with every edge right < the desired
+ * shape). Both in the desired shape: converged at the later of the two steps. The robots folded
+ * while the agents are in the desired shape: still settling (the robots follow the agents and have
+ * not caught up). The robots worse: their verdict, in
  * a line that says it is the robots' ("not converged (the robots, from odometry: max distance
  * error E m, shape error S m)"), with their findings, so that the run's reason gives their error.
  * @param timeStep h [s].
