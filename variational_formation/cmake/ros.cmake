@@ -148,6 +148,8 @@ if(CATKIN_ENABLE_TESTING)
   add_rostest(test/ros/safety_run.test ARGS rate:=0)
   add_rostest(test/ros/safety_run.test ARGS fault:=kill)
   add_rostest(test/ros/safety_run.test ARGS fault:=kill nodelet:=true)
+  # Issue 50: a diverging run with the filter on ends by itself, in simulate and formation.launch.
+  add_rostest(test/ros/diverging_safety.test)
   # live_tf: tf lookups at now() during a default run (/clock, /use_sim_time).
   foreach(t two_formations two_teams launch live_tf)
     add_rostest(test/ros/${t}.test)
