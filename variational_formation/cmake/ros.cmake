@@ -157,6 +157,8 @@ if(CATKIN_ENABLE_TESTING)
   # lockstep (equal to simulate until the filter binds on the other team) and timed.
   add_rostest(test/ros/cross_teams.test)
   add_rostest(test/ros/cross_teams.test ARGS mode:=timed)
+  # Issue 50: a diverging run with the filter on ends by itself, in simulate and formation.launch.
+  add_rostest(test/ros/diverging_safety.test)
   # live_tf: tf lookups at now() during a default run (/clock, /use_sim_time).
   foreach(t two_formations two_teams launch live_tf)
     add_rostest(test/ros/${t}.test)

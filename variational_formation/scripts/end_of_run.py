@@ -24,6 +24,10 @@ import sys
 import time
 
 POLL_SECONDS = 0.2
+# formation.launch starts this node first. A FATAL line can come while roslaunch still starts the
+# monitor, and a SIGINT then would make roslaunch fail that start (a red RLException): wait for
+# the monitor to have started, at most this long.
+MONITOR_START_SECONDS = 30.0
 
 
 def process_id(pid):
@@ -63,7 +67,7 @@ def main():
     launcher = os.getppid()
     # Set at parse time by this launch (see above); the launching process is its parent too.
     launch = str(rospy.get_param("~launch", "")).strip() or process_id(launcher)
-    state = {"over": False, "now": False, "marked": False}
+    state = {"over": False, "now": False, "marked": False, "monitor_started": False, "since": 0.0}
 
     def over(why, at_once=False):
         if not state["over"]:
@@ -77,6 +81,7 @@ def main():
             over("the run is over")
 
     def on_log(msg):
+        state["monitor_started"] = state["monitor_started"] or msg.name == monitor
         if msg.level == Log.FATAL and msg.name.startswith(namespace):
             over(f"{msg.name} failed at start-up", at_once=True)
 
@@ -90,6 +95,20 @@ def main():
         """The end_of_run nodes (parameter namespaces) of this launch, this one included."""
         return sorted(name[:-len("/launch")] for name in master.getParamNames()
                       if name.endswith("/launch") and str(other_node_param(name, "")).strip() == launch)
+
+    def monitor_started():
+        """Whether roslaunch has started the monitor (it registered or logged), or we waited long enough."""
+        if not state["monitor_started"]:
+            try:
+                master.lookupNode(monitor)
+                state["monitor_started"] = True
+            except Exception:  # not registered (yet): roslaunch is still starting the formation
+                state["since"] = state["since"] or time.time()
+                if time.time() - state["since"] < MONITOR_START_SECONDS:
+                    rospy.loginfo_throttle(5.0, f"end_of_run: waiting for {monitor} to start before ending the launch")
+                    return False
+                state["monitor_started"] = True
+        return True
 
     rospy.Subscriber("progress", RunProgress, on_progress)
     rospy.Subscriber("/rosout", Log, on_log, queue_size=100)
@@ -107,6 +126,8 @@ def main():
             rospy.logwarn_throttle(5.0, f"end_of_run: cannot ask the master which formations are over ({e})")
             continue
         # One sender: a second SIGINT would cut roslaunch's own shutdown short.
+        if everyone and not monitor_started():
+            continue
         if everyone and (state["now"] or not others or others[0] == rospy.get_name()):
             if started_by_roslaunch(launcher):
                 rospy.loginfo("end_of_run: every formation of this launch is over; ending it")

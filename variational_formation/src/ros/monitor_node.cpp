@@ -137,8 +137,14 @@ void MonitorNode::onBatch(std::size_t source, const ros::MessageEvent<variationa
 }
 
 bool MonitorNode::admit(int agent, const AgentState::ConstPtr& msg, const std::string& publisher) {
+  const std::string& node = agents_[static_cast<std::size_t>(agent)].node;
   if (!msg->failure.empty()) {
-    report(protocol::Failure{agents_[static_cast<std::size_t>(agent)].node + ": " + msg->failure});
+    report(protocol::Failure{node + ": " + msg->failure});
+    return false;
+  }
+  if (!finiteState(msg->position, msg->previous_position)) {
+    // Its owner diverged (an agent reports that itself, with its last good state): the run is over.
+    report(protocol::Failure{node + ": step " + std::to_string(msg->step) + " is not finite (the run diverged)"});
     return false;
   }
   if (!offer(agent, msg, publisher)) return false;

@@ -137,24 +137,27 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
     // Under a safety filter: the closest approach, the filter's activity, and a blocked run ends.
     std::unique_ptr<RunTracker> tracker;
     if (safety) tracker = std::make_unique<RunTracker>(scenario, schedule);
+    // The first non-finite step is written (traj.csv shows it) and ends the run: nothing after it
+    // means anything, and no check of the run is made on it.
     const auto observe = [&](const Integrator& integrator) {
       const long k = integrator.stepIndex();
-      Velocities v = integrator.velocities();
-      if (manoeuvre) subtractCommandedMotion(schedule.at(k > 0 ? k - 1 : 0), integrator.positions(), v);
-      shape.observe(k, integrator.positions(), v, integrator.commandedScale());
       writeTrajectoryRows(traj, integrator.stepIndex(), integrator.time(),
                           integrator.positions());
       if (withMetrics) {
         writeMetricsRow(metrics, measure(integrator, shapeErrorMeasuredAt(k, formation.agentCount(), scenario.steps)),
                         safety);
       }
-      if (divergedAt < 0 && !integrator.positions().allFinite()) {
-        divergedAt = integrator.stepIndex();
+      if (!integrator.positions().allFinite()) {
+        divergedAt = k;
+        return false;
       }
+      Velocities v = integrator.velocities();
+      if (manoeuvre) subtractCommandedMotion(schedule.at(k > 0 ? k - 1 : 0), integrator.positions(), v);
+      shape.observe(k, integrator.positions(), v, integrator.commandedScale());
       return !tracker || tracker->observe(integrator);
     };
     if (delayed) {
-      runDelayedScenario(scenario, start, delay, [&](const Integrator& integrator) { observe(integrator); });
+      runDelayedScenario(scenario, start, delay, observe);
     } else {
       runCentralised(scenario, method, start, manoeuvre ? &schedule : nullptr, observe);
     }

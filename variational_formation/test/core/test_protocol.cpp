@@ -330,6 +330,28 @@ TEST(TimedReferee, StartsOnceEveryAgentIsHeardAndKeepsTheNewestState) {
   EXPECT_TRUE(r.finished());
 }
 
+// Issue 50: every path that meets a non-finite position ends the run as diverged. Agents never
+// publish one (they fail with their last good state); one that reaches the recorder anyway fails
+// the recording with the divergence line (before, it went into the bag), and the monitor's
+// referee ends the run with it.
+TEST(RecorderProtocolTest, ANonFiniteStateFailsTheRecordingAsADivergence) {
+  const Scenario s = shortScenario("square", 10);
+  test::Recorder recorder(4, 16, 10, [](long) { return false; }, [](long) { return 0L; });
+  const auto state = [](int id, double x) {
+    return std::make_shared<const State>(State{id, 0, {x, 0.0}, {x, 0.0}});
+  };
+  EXPECT_TRUE(recorder.step(test::Recorder::StateArrived{0, state(0, 1.0)}).failed.empty());
+  const test::Recorder::Ready r = recorder.step(test::Recorder::StateArrived{1, state(1, std::nan(""))});
+  EXPECT_EQ(r.failed, "agent_1's step 0 is not finite (the run diverged)");
+  EXPECT_EQ(r.exit, 1);
+  EXPECT_TRUE(r.write.empty());
+  ASSERT_TRUE(r.report.has_value());
+  EXPECT_EQ(r.report->state, test::Progress::State::Failed);
+  test::Referee referee(s, 8, true, false);
+  EXPECT_TRUE(referee.step(test::Referee::RecorderReport{-1, false, r.failed, false}).finish);
+  EXPECT_EQ(referee.progressNow().reason, "the recorder failed: agent_1's step 0 is not finite (the run diverged)");
+}
+
 // ---- whole runs, event by event ----
 
 TEST(ProtocolRun, InOrderDeliveryFinishesWithEveryStateOnce) {

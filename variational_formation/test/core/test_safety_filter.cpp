@@ -288,11 +288,17 @@ TEST(SafetyFilter, KeepsTheDiscreteBarrierOverRandomSteps) {
   EXPECT_GT(binds, 5000);
 }
 
-TEST(SafetyFilter, LeavesTheNextPositionUntouchedWhileNothingBinds) {
+/// The settings of the README's deployments: r = 0.25 m, R = 1 m, γ = 0.2, no speed limit.
+SafetySettings deploymentSettings() {
   SafetySettings s;
   s.radius = 0.25;
   s.sensingRadius = 1.0;
   s.gamma = 0.2;
+  return s;
+}
+
+TEST(SafetyFilter, LeavesTheNextPositionUntouchedWhileNothingBinds) {
+  SafetySettings s = deploymentSettings();
   const double q[2] = {0.1, 0.7};
   double next[2] = {0.1 + 1.0 / 3.0, 0.7 - 1e-3};
   const double before[2] = {next[0], next[1]};
@@ -310,6 +316,31 @@ TEST(SafetyFilter, LeavesTheNextPositionUntouchedWhileNothingBinds) {
   EXPECT_TRUE(g.projection.changed);
   EXPECT_GT(next[0], -0.4);
   EXPECT_EQ(g.projection.active, std::vector<int>{0});
+}
+
+// A diverging run (issue 50): an update that is no longer finite must reach the run as it is,
+// with or without a speed limit and with a neighbour in reach, not be held at q (δ = 0), which
+// hid the divergence and left the run going.
+TEST(SafetyFilter, PassesANonFiniteStepOnUntouched) {
+  SafetySettings s = deploymentSettings();
+  const double q[2] = {0.1, 0.7};
+  std::vector<SensedAgent> sensed(1);
+  sensed[0].id = 3;
+  sensed[0].position[0] = 0.4;  // 0.3 m ahead: in reach, and a step toward it binds
+  sensed[0].position[1] = 0.7;
+  const double nan = std::nan("");
+  for (double maxSpeed : {kInf, 2.0}) {
+    s.maxSpeed = maxSpeed;
+    for (const auto& bad : {std::vector<double>{nan, 0.7}, {kInf, 0.7}, {-kInf, kInf}, {0.4, nan}}) {
+      double next[2] = {bad[0], bad[1]};
+      const SafeStep f = filterNextPosition(s, 0.02, 2, q, next, sensed, {});
+      const std::string where = "max speed " + std::to_string(maxSpeed) + ", next (" + std::to_string(bad[0]) +
+                                ", " + std::to_string(bad[1]) + ")";
+      EXPECT_FALSE(f.projection.changed) << where;
+      EXPECT_TRUE(f.projection.active.empty()) << where;
+      EXPECT_EQ(std::memcmp(next, bad.data(), sizeof next), 0) << where << ": became (" << next[0] << ", " << next[1] << ")";
+    }
+  }
 }
 
 }  // namespace

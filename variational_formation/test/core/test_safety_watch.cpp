@@ -8,9 +8,11 @@
 #include <random>
 #include <string>
 
+#include "variational_formation_core/agents/formation_monitor.hpp"
 #include "variational_formation_core/common/invalid_input.hpp"
 #include "variational_formation_core/safety/safety_watch.hpp"
 #include "variational_formation_core/model/scenario.hpp"
+#include "test_support.hpp"
 
 namespace vf {
 namespace {
@@ -50,6 +52,34 @@ TEST(SafetyWatch, MinSeparationIsTheClosestPairOfEveryStep) {
     watch.observe(step, q, 1.0, false);
     EXPECT_EQ(watch.minSeparation(), bruteClosest(q)) << "step " << step;
   }
+}
+
+// A diverging run (issue 50): the monitor measured the agents' last finite step, far out, and its
+// closest pair search never ended (the monitor spun and the result file stayed "running"). The
+// monitor's path, FormationMonitor's snapshot then SafetyWatch, must end on any finite step.
+TEST(SafetyWatch, EndsOnAStepFarOut) {
+  const Scenario sc = parseScenario(kLine, "t.yaml");
+  const std::vector<std::vector<double>> far = {{-1e300, 0.0}, {1e300, 0.0}, {0.0, 1e300}};
+  const auto measureFarOut = [&sc, &far](SafetyWatch& watch) {
+    FormationMonitor monitor(sc);
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_EQ(monitor.add(i, 0, far[static_cast<std::size_t>(i)], far[static_cast<std::size_t>(i)], 0),
+                FormationMonitor::Receipt::Accepted);
+    }
+    const std::vector<FormationSnapshot> done = monitor.takeCompleted();
+    EXPECT_EQ(done.size(), 1u);
+    for (const FormationSnapshot& s : done) watch.observe(0, s.positions, s.metrics.maxDistanceError, s.converged);
+  };
+  test::expectEndsWithin(10, [&] {
+    SafetyWatch watch(sc, 10.0, false);
+    measureFarOut(watch);
+  });
+  if (HasFailure()) return;
+  SafetyWatch watch(sc, 10.0, false);
+  measureFarOut(watch);
+  // No pair is near enough for its squared distance to be a double: none is named.
+  EXPECT_EQ(watch.minSeparation(), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(watch.resultLines(), "closest_approach: ~\nfilter_active_steps: 0\n");
 }
 
 TEST(SafetyWatch, LockstepSumsTheStepsValuesAndFindsTheBlock) {

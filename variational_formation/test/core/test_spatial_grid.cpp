@@ -7,8 +7,10 @@
 #include <random>
 #include <vector>
 
+#include "variational_formation_core/common/invalid_input.hpp"
 #include "variational_formation_core/common/standard_normal.hpp"
 #include "variational_formation_core/model/spatial_grid.hpp"
+#include "test_support.hpp"
 
 namespace vf {
 namespace {
@@ -118,6 +120,47 @@ TEST(ClosestPair, AgreesWithBruteForce) {
   Positions bad(2, 2);
   bad << 0.0, std::nan(""), 0.0, 0.0;
   EXPECT_TRUE(std::isnan(closestPair(bad, 1.0).distance));
+}
+
+// A diverging run (issue 50): positions so far out that the bounding box's diagonal overflows to
+// +inf. The grid kept doubling its cell for ever (a run with safety: hung); it must end, with the
+// exact pair where a squared distance is a double and +inf (no pair) where none is.
+TEST(ClosestPair, EndsFarOutWhereDistancesOverflow) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  Positions apart(2, 3);  // every pair farther than 1e154 m: no squared distance is finite
+  apart << -1e300, 1e300, 0.0,
+           0.0, 0.0, 1e300;
+  const double far = std::ldexp(1.0, 330);  // ~2e99 m, a power of two: its square and root are exact
+  Positions mixed(3, 4);  // a pair `far` apart (found by doubling), two agents at +-1e300
+  mixed << 1e300, 0.0, 0.0, -1e300,
+           0.0, 0.0, 0.0, 5.0,
+           0.0, 0.0, far, 0.0;
+  for (const Positions* q : {&apart, &mixed}) {
+    test::expectEndsWithin(10, [q] { closestPair(*q, 0.5); });
+    if (HasFailure()) return;
+  }
+  const ClosestPair none = closestPair(apart, 0.5);
+  EXPECT_EQ(none.distance, kInf);
+  EXPECT_EQ(none.first, -1);
+  const ClosestPair c = closestPair(mixed, 0.5);
+  EXPECT_EQ(c.distance, far);
+  EXPECT_EQ(c.first, 1);
+  EXPECT_EQ(c.second, 2);
+  // The grid itself far out, with cells up to +inf: exactly the pairs whose squared distance is
+  // below the radius's square, as brute force finds them.
+  for (double cell : {1.0, 1e154, 1e200, kInf}) {
+    SpatialGrid grid;
+    grid.build(mixed, cell);
+    std::vector<int> start, all;
+    grid.neighbourLists(mixed, cell, start, all);
+    for (int i = 0; i < 4; ++i) {
+      const std::vector<int> listed(all.begin() + start[static_cast<std::size_t>(i)],
+                                    all.begin() + start[static_cast<std::size_t>(i) + 1]);
+      EXPECT_EQ(listed, bruteForce(mixed, i, cell)) << "cell " << cell << " agent " << i;
+    }
+  }
+  EXPECT_NE(test::thrown([&] { closestPair(mixed, 0.0); }).find("closest pair: the first cell must be > 0 m, got 0"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -2,7 +2,10 @@
 // Small fixtures shared by the core tests.
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <cstdlib>
+#include <functional>
 #include <initializer_list>
 #include <string>
 #include <vector>
@@ -86,6 +89,22 @@ inline std::vector<Positions> manoeuvreTrajectory(const Scenario& s, const Comma
     trajectory.push_back(reference.positions());
   }
   return trajectory;
+}
+
+/**
+ * Expects `work` to end within `seconds`: it runs in a child process (a gtest death test) that
+ * SIGALRM kills if it hangs, so a hang fails the test instead of hanging it. Check what it
+ * computes afterwards, in the test itself, once this passed (`if (HasFailure()) return;`).
+ */
+inline void expectEndsWithin(unsigned seconds, const std::function<void()>& work) {
+  EXPECT_EXIT(
+      {
+        alarm(seconds);
+        work();
+        std::_Exit(0);
+      },
+      ::testing::ExitedWithCode(0), "")
+      << "did not end within " << seconds << " s (killed by SIGALRM: it hangs)";
 }
 
 }  // namespace test

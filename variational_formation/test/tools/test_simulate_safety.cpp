@@ -5,13 +5,17 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <limits>
+#include <memory>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "simulate_test_support.hpp"
+#include "../core/test_support.hpp"
 #include "variational_formation_core/common/invalid_input.hpp"
 #include "variational_formation_core/agents/run_tracker.hpp"
 #include "variational_formation_core/integrators/step_metrics.hpp"
@@ -205,6 +209,72 @@ TEST(SimulateSafety, ABlockedRunEndsEarlyAndSaysWhoBlocks) {
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("simulate: error: the formation did not converge (blocked: agents 1, 2)"), std::string::npos)
       << r.err;
+}
+
+// Issue 50: the README's deploy6 (safety on) at h = 0.5, above the stability limit, hung in the
+// closest pair search instead of ending as the same run without safety: it must end at the first
+// non-finite step with the divergence line and exit status 1, its trajectory ending at that step.
+TEST(SimulateSafety, ADivergingRunEndsAtItsFirstNonFiniteStep) {
+  const std::string file = deploy(6, 3, true, false), traj = tempPath("diverging.csv");
+  for (const char* steps : {"10", "3000"}) {
+    test::expectEndsWithin(20, [&] {
+      simulate({"--scenario", file, "--out", traj, "--metrics", tempPath("diverging_m.csv"), "--time-step", "0.5",
+                "--steps", steps});
+    });
+    if (HasFailure()) return;
+    const CliResult r = simulate({"--scenario", file, "--out", traj, "--metrics", tempPath("diverging_m.csv"), "--time-step", "0.5",
+                  "--steps", steps});
+    EXPECT_EQ(r.status, 1) << r.err;
+    long firstNonFinite = -1, lastStep = -1;
+    std::ifstream in(traj);
+    std::string line;
+    std::getline(in, line);  // the header
+    while (std::getline(in, line)) {
+      double step = 0.0, t = 0.0, x = 0.0, y = 0.0;
+      long agent = 0;
+      ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%ld,%lf,%lf", &step, &t, &agent, &x, &y), 5) << line;
+      lastStep = static_cast<long>(step);
+      if (firstNonFinite < 0 && !(std::isfinite(x) && std::isfinite(y))) firstNonFinite = lastStep;
+    }
+    ASSERT_GT(firstNonFinite, 0) << "steps " << steps << ": the run did not diverge";
+    EXPECT_EQ(lastStep, firstNonFinite) << "steps " << steps << ": the run went on after diverging";
+    const std::string error = "simulate: error: the run diverged: non-finite positions from step " +
+                              std::to_string(firstNonFinite) + " (try a smaller --time-step)\n";
+    ASSERT_GE(r.err.size(), error.size()) << r.err;
+    EXPECT_EQ(r.err.substr(r.err.size() - error.size()), error);
+    EXPECT_EQ(r.out, "") << "a diverged run says nothing of its formation";
+  }
+}
+
+// The metrics and the run's tracker with the filter on, at a step far out (a diverging run's
+// last finite one): both looked for the closest pair for ever.
+TEST(SimulateSafety, MetricsAndTrackerEndOnAStepFarOut) {
+  Scenario s = loadScenario(deploy(6, 3, true, false));
+  for (int i = 0; i < s.agentCount(); ++i) {
+    s.initialPositions(0, i) = (i % 2 ? 1e300 : -1e300) * (1.0 + i);
+    s.initialPositions(1, i) = (i % 3 ? 1e299 : -1e299) * (1.0 + i);
+  }
+  const Formation formation = makeFormation(s);
+  const CommandSchedule none;
+  const auto farOut = [&](StepMetrics& m, RunTracker& tracker) {
+    const std::unique_ptr<Integrator> integrator = makeIntegrator(
+        Method::Variational, formation, s.initialPositions, s.initialVelocities, s.timeStep, s.dampingGain,
+        StartMethod::Variational);
+    integrator->attachSafety(makeSafetyStage(s));
+    m = measure(*integrator);
+    tracker.observe(*integrator);
+  };
+  test::expectEndsWithin(10, [&] {
+    StepMetrics m;
+    RunTracker tracker(s, none);
+    farOut(m, tracker);
+  });
+  if (HasFailure()) return;
+  StepMetrics m;
+  RunTracker tracker(s, none);
+  farOut(m, tracker);
+  EXPECT_EQ(m.minSeparation, std::numeric_limits<double>::infinity());  // no squared distance is a double
+  EXPECT_EQ(tracker.closestApproach().first, -1);
 }
 
 TEST(SimulateSafety, RefusesWhatTheFilterCannotApplyTo) {

@@ -1,8 +1,7 @@
 #include "variational_formation_core/agents/formation_monitor.hpp"
 
-#include <cmath>
-
 #include "variational_formation_core/common/invalid_input.hpp"
+#include "variational_formation_core/common/number_checks.hpp"
 #include "variational_formation_core/model/metrics.hpp"
 #include "variational_formation_core/manoeuvres/commanded_frame.hpp"
 
@@ -40,9 +39,7 @@ FormationMonitor::Receipt FormationMonitor::add(long id, long step, const std::v
   if (static_cast<int>(position.size()) != d || static_cast<int>(previousPosition.size()) != d) {
     return Receipt::WrongDimension;
   }
-  for (int a = 0; a < d; ++a) {
-    if (!std::isfinite(position[a]) || !std::isfinite(previousPosition[a])) return Receipt::NonFinite;
-  }
+  if (!finiteState(position, previousPosition)) return Receipt::NonFinite;
   if (step < 0 || step > lastAllowed || (scenario_.steps > 0 && step > scenario_.steps)) return Receipt::ImpossibleStep;
   if (step < next_) return Receipt::Duplicate;
   Pending& p = pending_[step];

@@ -104,7 +104,7 @@ double DelayedVariationalIntegrator::energy() const {
 }
 
 void runDelayedScenario(const Scenario& scenario, StartMethod start, const DelaySettings& delay,
-                        const std::function<void(const Integrator&)>& observe) {
+                        const std::function<bool(const Integrator&)>& observe) {
   if (scenario.steps <= 0) {
     throw InvalidInput("steps: must be >= 1 for a centralised run (0 = unbounded is only for the ROS run)");
   }
@@ -112,10 +112,10 @@ void runDelayedScenario(const Scenario& scenario, StartMethod start, const Delay
   DelayedVariationalIntegrator integrator(formation, scenario.initialPositions,
                                           scenario.initialVelocities, scenario.timeStep,
                                           scenario.dampingGain, start, delay);
-  observe(integrator);
+  if (!observe(integrator)) return;
   for (long k = 0; k < scenario.steps; ++k) {
     integrator.step();
-    observe(integrator);
+    if (!observe(integrator)) return;
   }
 }
 

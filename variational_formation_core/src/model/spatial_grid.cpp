@@ -5,6 +5,9 @@
 #include <cstdint>
 #include <limits>
 
+#include "variational_formation_core/common/invalid_input.hpp"
+#include "variational_formation_core/common/number_checks.hpp"
+
 namespace vf {
 
 namespace {
@@ -181,13 +184,16 @@ ClosestPair closestPair(const Positions& q, double hint) {
     best.distance = std::nan("");
     return best;
   }
-  // Beyond the bounding box's diagonal every pair is within one cell of the other.
+  if (!(hint > 0.0)) throw InvalidInput("closest pair: the first cell must be > 0 m, got " + formatNumber(hint));
+  // Beyond the bounding box's diagonal every pair is within one cell of the other. Far out
+  // (a diverging run) the diagonal may overflow to +inf: once cell^2 does too, every pair whose
+  // squared distance is a double (< ~1.3e154 m apart) has been measured, and no other can be.
   const double diagonal = (q.rowwise().maxCoeff() - q.rowwise().minCoeff()).norm();
   SpatialGrid grid;
   for (double cell = hint;; cell *= 2.0) {
     grid.build(q, cell);
     const ClosestPair best = grid.closestWithin(q, cell);
-    if (best.first >= 0 || cell > diagonal) return best;
+    if (best.first >= 0 || cell > diagonal || std::isinf(cell * cell)) return best;
   }
 }
 

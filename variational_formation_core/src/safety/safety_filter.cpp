@@ -151,6 +151,11 @@ void projectDisplacement(int d, const double* delta0, const std::vector<HalfSpac
   }
   for (int a = 0; a < d; ++a) result.delta[a] = delta0[a];
   if (inside) return;  // nothing binds: δ0 itself
+  // A non-finite δ0 (a diverging run) is no step to project: it is passed on untouched, so the
+  // run sees the divergence, instead of δ = 0 holding the agent where it is.
+  bool finite = true;
+  for (int a = 0; a < d; ++a) finite = finite && std::isfinite(delta0[a]);
+  if (!finite) return;
   result.changed = true;
 
   // Only half-spaces that reach into |δ| <= min(|δ0|, ρ) can bind (margin for rounding).

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cmath>
 #include <string>
 
 namespace vf {
@@ -25,5 +26,18 @@ std::string formatNumber(double value);
 /// A computed number for a person to read (a sum, a quotient, a derived limit): 6 significant
 /// digits, so 0.1 + 0.02 reads "0.12", not "0.12000000000000001" ("-inf", "nan" as above).
 std::string formatRounded(double value);
+
+/// Every coordinate of a state (its position and previous position, any containers of doubles)
+/// is finite: false once a run has diverged.
+template <class Position, class Previous>
+bool finiteState(const Position& position, const Previous& previousPosition) {
+  for (double x : position) {
+    if (!std::isfinite(x)) return false;
+  }
+  for (double x : previousPosition) {
+    if (!std::isfinite(x)) return false;
+  }
+  return true;
+}
 
 }  // namespace vf

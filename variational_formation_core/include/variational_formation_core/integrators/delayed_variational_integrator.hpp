@@ -82,10 +82,11 @@ class DelayedVariationalIntegrator : public Integrator {
 };
 
 /**
- * runScenario (simulation.hpp) with the delayed model: observe at steps 0..steps.
+ * runScenario (simulation.hpp) with the delayed model: observe at steps 0..steps; the run ends
+ * after a step at which `observe` returns false (a diverged one, in simulate).
  * @throws InvalidInput on bad settings or steps = 0.
  */
 void runDelayedScenario(const Scenario& scenario, StartMethod start, const DelaySettings& delay,
-                        const std::function<void(const Integrator&)>& observe);
+                        const std::function<bool(const Integrator&)>& observe);
 
 }  // namespace vf

@@ -11,7 +11,9 @@ namespace vf {
 
 /// The closest pair of a configuration.
 struct ClosestPair {
-  double distance = std::numeric_limits<double>::infinity();  ///< [m]; +inf with fewer than two agents, NaN if a position is not finite
+  /// [m]; +inf with fewer than two agents or none closer than ~1.3e154 m (whose squared distance
+  /// overflows a double: a diverging run), NaN if a position is not finite
+  double distance = std::numeric_limits<double>::infinity();
   int first = -1;   ///< the pair's ids, first < second (-1 if none)
   int second = -1;
 };
@@ -67,7 +69,8 @@ ClosestPair closestListed(const Positions& q, double radius, const std::vector<i
 /**
  * The closest pair of q at O(n) for bounded density: a SpatialGrid of cell `hint` [m] > 0
  * (e.g. the sensing radius), doubled until some pair lies within it. Ties go to the smallest
- * (first, second).
+ * (first, second). Ends for any finite q, however far out (ClosestPair::distance).
+ * @throws InvalidInput if hint is not > 0.
  */
 ClosestPair closestPair(const Positions& q, double hint);
 

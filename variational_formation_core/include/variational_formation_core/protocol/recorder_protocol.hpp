@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "variational_formation_core/common/invalid_input.hpp"
+#include "variational_formation_core/common/number_checks.hpp"
 #include "variational_formation_core/protocol/progress.hpp"
 #include "variational_formation_core/protocol/step_assembler.hpp"
 #include "variational_formation_core/agents/record_ledger.hpp"
@@ -193,6 +194,13 @@ class RecorderProtocol {
 
  private:
   void record(Ready& r, int agent, const State& s) {
+    if (!finiteState(s->position, s->previous_position)) {
+      // Agents never publish a diverged step (they fail with their last good one): one that
+      // comes anyway ends the run as diverged, not a bag with NaNs in it.
+      fail(r, "agent_" + std::to_string(agent) + "'s step " + std::to_string(s->step) +
+                  " is not finite (the run diverged)");
+      return;
+    }
     RecordLedger::Arrival arrival = RecordLedger::Arrival::New;
     try {
       arrival = ledger_.addState(agent, s->step, s->position, s->previous_position);

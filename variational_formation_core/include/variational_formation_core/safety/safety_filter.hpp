@@ -38,7 +38,7 @@ struct Projection {
  * are left out first (the projection onto a convex set holding 0 is no longer than δ0), so only
  * the few near neighbours count. Afterwards δ is shrunk toward 0 if rounding left any a·δ < b,
  * so that a·δ >= b holds as computed. Deterministic: the same numbers in the same order give
- * the same δ everywhere.
+ * the same δ everywhere. A non-finite δ0 (a diverging run) comes back untouched (changed false).
  * @param dimension d (2 or 3). @param delta0 δ0, d doubles [m].
  * @param maxStep ρ [m] (+inf: no ball).
  */
@@ -96,7 +96,8 @@ void filterDisplacement(const SafetySettings& settings, double timeStep, int dim
 
 /**
  * Filters one agent's next position in place: qNext = q + δ when a constraint binds, and is left
- * untouched (today's update, bit for bit) when none does.
+ * untouched (today's update, bit for bit) when none does, or when qNext - q is not finite (so that
+ * a diverging run ends as diverged).
  * @param q q_i^{k+1}, @param qNext q̂_i^{k+2} in, q_i^{k+2} out; d doubles each [m].
  */
 SafeStep filterNextPosition(const SafetySettings& settings, double timeStep, int dimension, const double* q,
