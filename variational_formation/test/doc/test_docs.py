@@ -11,6 +11,9 @@
 - A default the code gives as a plain literal is one of the defaults the document gives.
 - Every node executable, nodelet and node script of the package has a section there, and each
   <param> a launch file gives one of its nodes is listed in that node's section.
+- Every launch file has a section in doc/ros_api.md's "Launch files" that names each of its
+  arguments (every <arg> of the file's own that has no fixed value); a table of arguments names
+  only arguments the file has, and gives each plain default (not a $(...) expression) the file gives.
 - Every relative link in README.md and doc/*.md reaches an existing file and heading.
 - No other page keeps a parameter table of its own (one list), and README.md has at most 200
   lines.
@@ -486,6 +489,36 @@ class Docs(unittest.TestCase):
                             wrong.append(f"{relative(path)}: node {node.get('name')} ({kind}) gets ~{name}, "
                                          "which its section of doc/ros_api.md does not list")
         self.assertGreater(checked, 20, "implausibly few launch parameters found")
+        self.assertEqual(wrong, [], "\n".join(wrong))
+
+    def test_launch_arguments_are_documented(self):
+        text = read(API)
+        sections = dict(re.findall(r"^### (\S+)\n(.*?)(?=^##)", text[text.index("\n## Launch files"):] + "\n##",
+                                   re.M | re.S))
+        wrong, checked = [], 0
+        for folder, _, names in os.walk(os.path.join(ROOT, "launch")):
+            for launch in sorted(n for n in names if n.endswith(".launch")):
+                path = os.path.join(folder, launch)
+                key = os.path.relpath(path, os.path.join(ROOT, "launch"))
+                section = sections.get(key)
+                if section is None:
+                    wrong.append(f"{relative(path)}: no section '### {key}' under 'Launch files' in doc/ros_api.md")
+                    continue
+                args = {a.get("name"): a.get("default") for a in doc_commands.ElementTree.parse(path).getroot()
+                        if a.tag == "arg" and a.get("value") is None}
+                named = set(re.findall(r"`([\w/]+)`", section))
+                wrong += [f"{relative(path)}: argument {a} is not in its section of doc/ros_api.md"
+                          for a in sorted(set(args) - named)]
+                checked += len(args)
+                for row in re.findall(r"^\| (`.*?) \| (.*?) \|", section, re.M):
+                    for name in re.findall(r"`(\w+)`", row[0]):
+                        default = args.get(name)
+                        if name not in args:
+                            wrong.append(f"doc/ros_api.md, {key}: `{name}` is not an argument of {relative(path)}")
+                        elif default is not None and "$(" not in default and default not in row[1].replace("`", ""):
+                            wrong.append(f"doc/ros_api.md, {key}: `{name}`: the file's default is '{default}', "
+                                         f"the table says '{row[1]}'")
+        self.assertGreater(checked, 60, "implausibly few launch arguments found")
         self.assertEqual(wrong, [], "\n".join(wrong))
 
     def test_one_parameter_list(self):
