@@ -14,6 +14,8 @@
 - Every launch file has a section in doc/ros_api.md's "Launch files" that names each of its
   arguments (every <arg> of the file's own that has no fixed value); a table of arguments names
   only arguments the file has, and gives each plain default (not a $(...) expression) the file gives.
+- What the pages show scenario_info printing (a console block's `$ rosrun ... scenario_info`
+  and the lines after it) is what it prints: its advice and the pages' stay the same.
 - Every relative link in README.md and doc/*.md reaches an existing file and heading.
 - No other page keeps a parameter table of its own (one list), and README.md has at most 200
   lines.
@@ -21,7 +23,10 @@
   tools, and the package of each `rosrun PKG EXE` and `roslaunch PKG FILE`, come from a Debian
   package that package.xml's keys install (scripts/debian_packages.txt, with its dependencies),
   the executable or launch file exists, and this package's programs, launch files and
-  run_formation.sh take the options and arguments the command gives them.
+  run_formation.sh take the options and arguments the command gives them, and a command that
+  gives a value to one of the options the program's usage line requires gives them all (prose
+  about an option, `simulate --out`, gives none). A tool of the package named bare in prose
+  (`simulate --scenario x.yaml`) is checked as its rosrun command.
 - No file of the repository refers to a file outside it (the docs stand alone).
 
   test_docs.py [--gtest_output=xml:PATH]     (rosunit; --text for a plain run)
@@ -30,6 +35,7 @@ import ast
 import os
 import re
 import shutil
+import subprocess
 import sys
 import unittest
 
@@ -521,6 +527,26 @@ class Docs(unittest.TestCase):
         self.assertGreater(checked, 60, "implausibly few launch arguments found")
         self.assertEqual(wrong, [], "\n".join(wrong))
 
+    def test_quoted_scenario_info_output_is_the_tools(self):
+        import roslib.packages
+        tool = roslib.packages.find_node(doc_commands.PKG, "scenario_info")
+        self.assertTrue(tool, "scenario_info is not built")
+        fence = re.compile(r"^```console\n(.*?)^```", re.M | re.S)
+        compared = 0
+        for page in doc_commands.pages():
+            for block in fence.findall(read(page)):
+                parts = re.split(r"^\$ ", block, flags=re.M)[1:]
+                for part in parts:
+                    command, *shown = part.rstrip("\n").split("\n")
+                    words = command.split()
+                    if words[:3] != ["rosrun", doc_commands.PKG, "scenario_info"]:
+                        continue
+                    result = subprocess.run(tool[:1] + words[3:], capture_output=True, text=True, timeout=60, cwd=REPOSITORY)
+                    compared += 1
+                    self.assertEqual(shown, (result.stderr + result.stdout).splitlines(),
+                                     f"{relative(page)}: what `{command}` prints")
+        self.assertGreater(compared, 0, "no quoted scenario_info output found")
+
     def test_one_parameter_list(self):
         pages = [os.path.join(REPOSITORY, "README.md")] + [
             os.path.join(REPOSITORY, "doc", n) for n in sorted(os.listdir(os.path.join(REPOSITORY, "doc"))) if n.endswith(".md")]
@@ -563,7 +589,10 @@ class Docs(unittest.TestCase):
         documented = set(self.doc.specs) | set(self.doc.references)
         wrong, checked, provided = [], 0, []  # provided: (where, what, path) to look up in dpkg
 
+        tools = {name for name in programs if os.path.isfile(os.path.join(ROOT, "src", "tools", name + "_cli.cpp"))}
         for where, words in doc_commands.every_command():
+            if words[0] in tools:  # a tool named bare in prose: `simulate --scenario deploy6.yaml`
+                words = ["rosrun", doc_commands.PKG] + words
             tool = words[0]
             if re.fullmatch(r"(ros|catkin)\w*", tool):
                 checked += 1
@@ -623,6 +652,13 @@ class Docs(unittest.TestCase):
         else:
             arguments = None
         sources = "".join(read(p) for p in doc_commands.program_sources(name, programs)) if tool == "rosrun" else ""
+        given = {w.split("=", 1)[0] for w in words[3:]}
+        required = doc_commands.required_options(name, sources) if tool == "rosrun" else set()
+        # A run gives a required option a value; prose about options (`simulate --out`) does not.
+        valued = {w for w, after in zip(words[3:], words[4:]) if w in required and not after.startswith("-")}
+        if valued and not given & {"--help", "-h"}:
+            for option in sorted(required - given):
+                wrong.append(f"{where}: {command}: the required option {option} is missing")
         for word in words[3:]:
             option, assigned = word.split("=", 1)[0], word.split(":=", 1)[0]
             if option.startswith("--") and f'"{option}"' not in sources and f"'{option}'" not in sources:
