@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "variational_formation_core/common/invalid_input.hpp"
+#include "variational_formation/ros/frames.hpp"
 #include "variational_formation/ros/parameters.hpp"
 
 namespace vf {
@@ -23,8 +24,6 @@ GoalSettings goalSettings(ros::NodeHandle& pnh) {
   validateGoalSettings(s);
   return s;
 }
-
-std::string withoutSlash(const std::string& frame) { return !frame.empty() && frame[0] == '/' ? frame.substr(1) : frame; }
 
 }  // namespace
 
@@ -65,7 +64,7 @@ void GoalServer::onGoal() {
   }
   const geometry_msgs::PoseStamped& t = goal->target_pose;
   try {
-    if (!t.header.frame_id.empty() && withoutSlash(t.header.frame_id) != withoutSlash(worldFrame_)) {
+    if (!t.header.frame_id.empty() && !isFrame(t.header.frame_id, worldFrame_)) {
       throw InvalidInput("goal.target_pose.header.frame_id: must be the formation's frame '" + worldFrame_ +
                          "' (or empty), got '" + t.header.frame_id + "'");
     }

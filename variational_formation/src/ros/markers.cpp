@@ -58,6 +58,12 @@ geometry_msgs::Vector3 vector3(const Vector3& v) {
 
 }  // namespace
 
+double agentSphereRadius(const Formation& formation) {
+  double scale = formation.edges().empty() ? 1.0 : HUGE_VAL;
+  for (const Edge& e : formation.edges()) scale = std::min(scale, e.desiredDistance);
+  return std::max(0.05, 0.1 * scale);
+}
+
 std_msgs::ColorRGBA agentColour(int agent) {
   static const double palette[8][3] = {{0.90, 0.10, 0.10}, {0.10, 0.45, 0.90}, {0.10, 0.75, 0.20},
                                        {0.95, 0.60, 0.05}, {0.60, 0.20, 0.80}, {0.05, 0.80, 0.80},
@@ -89,13 +95,6 @@ FormationStatus toStatusMessage(const FormationSnapshot& s) {
 namespace {
 
 using visualization_msgs::Marker;
-
-/// Marker radius: a tenth of the shortest desired edge (1 m without edges), at least 5 cm.
-double markerRadius(const Formation& formation) {
-  double scale = formation.edges().empty() ? 1.0 : HUGE_VAL;
-  for (const Edge& e : formation.edges()) scale = std::min(scale, e.desiredDistance);
-  return std::max(0.05, 0.1 * scale);
-}
 
 /// Where the desired shape is drawn: its agents moved so that its centroid is the formation's,
 /// and, under a commanded motion, turned and scaled as the commands have so far.
@@ -136,7 +135,7 @@ Marker commandArrow(const Ghost& ghostAt, double radius, const ros::Time& stamp)
 
 /// The agents as one sphere list (a sphere of its colour at each q_i): one marker whatever the
 /// agent count, the same spheres rviz would draw from a marker per agent.
-Marker agentSpheres(const FormationSnapshot& s, int n, double radius, const ros::Time& stamp) {
+Marker agentSpheres(const FormationSnapshot& s, int n, double radius, AgentSpheres look, const ros::Time& stamp) {
   Marker agents = base("agents", 0, Marker::SPHERE_LIST, stamp);
   agents.scale.x = agents.scale.y = agents.scale.z = 2.0 * radius;
   agents.color = rgba(1.0, 1.0, 1.0, 1.0);  // rviz takes colors[] per point
@@ -145,6 +144,7 @@ Marker agentSpheres(const FormationSnapshot& s, int n, double radius, const ros:
   for (int i = 0; i < n; ++i) {
     agents.points.push_back(point(column3(s.positions, i)));
     agents.colors.push_back(agentColour(i));
+    if (look == AgentSpheres::Halos) agents.colors.back().a = kHaloAlpha;
   }
   return agents;
 }
@@ -266,15 +266,15 @@ long allMarkersEvery(int trailStride, double timeStep) {
 
 visualization_msgs::MarkerArray makeMarkers(const FormationSnapshot& s, const Formation& formation,
                                             const Trails& trails, const CommandSchedule* schedule,
-                                            double timeStep, MarkerParts parts) {
+                                            double timeStep, MarkerParts parts, AgentSpheres spheres) {
   visualization_msgs::MarkerArray out;
   out.markers.reserve(6);
   const ros::Time stamp = ros::Time::now();
   const int n = formation.agentCount();
-  const double radius = markerRadius(formation);
+  const double radius = agentSphereRadius(formation);
   const Ghost ghostAt(s, formation, schedule, timeStep);
   const bool all = parts == MarkerParts::All;
-  out.markers.push_back(agentSpheres(s, n, radius, stamp));
+  out.markers.push_back(agentSpheres(s, n, radius, spheres, stamp));
   if (all) out.markers.push_back(trailLines(s, trails, radius, stamp));
   addEdgesAndGhostEdges(s, formation, ghostAt, radius, stamp, all, out);
   if (all) out.markers.push_back(ghostAgents(formation, ghostAt, radius, stamp));

@@ -56,8 +56,10 @@ MonitorNode::Published MonitorNode::publishSnapshot(const FormationSnapshot& s, 
   if (edge || (step % markerEvery_ == 0 && (recording_ || markersPub_.getNumSubscribers() > 0))) {
     const bool all = edge || allMarkersStep_ < 0 || step < allMarkersStep_ || step - allMarkersStep_ >= allMarkersEvery_;
     if (all) allMarkersStep_ = step;
+    // A robot run's agents are halos round the robots' bodies, which their world draws.
     out.second = makeMarkers(s, measure().formation(), trails_, commandSchedule(), scenario_.timeStep,
-                             all ? MarkerParts::All : MarkerParts::Moving);
+                             all ? MarkerParts::All : MarkerParts::Moving,
+                             robots_ ? AgentSpheres::Halos : AgentSpheres::Solid);
     if (scenario_.safety) addSafetyMarkers(s, *scenario_.safety, scenario_.obstacles, out.second);
     for (auto& m : out.second.markers) {
       m.header.stamp = stamp;

@@ -31,6 +31,8 @@ void MonitorNode::setUpRobots(ros::NodeHandle& nh, ros::NodeHandle& pnh, bool ti
   } catch (const InvalidInput& e) {
     throw InvalidInput(std::string("~") + e.what());  // the core names the parameter without '~'
   }
+  odomFrames_ = std::make_unique<FrameGate>(worldFrame_, "monitor", "that robot is not measured until odometry in '" +
+                                                                         worldFrame_ + "' comes");
   for (int i = 0; i < scenario_.agentCount(); ++i) {
     odomSubs_.push_back(nh.subscribe<nav_msgs::Odometry>(
         "robot_" + std::to_string(i) + "/odom", 10,
@@ -46,6 +48,7 @@ void MonitorNode::setUpRobots(ros::NodeHandle& nh, ros::NodeHandle& pnh, bool ti
 void MonitorNode::onOdometry(int id, const nav_msgs::Odometry& msg) {
   const auto& p = msg.pose.pose.position;
   const auto& o = msg.pose.pose.orientation;
+  if (!odomFrames_->admit(msg.header.frame_id, odomSubs_[static_cast<std::size_t>(id)].getTopic())) return;
   try {
     robots_->addOdometry(id, ros::WallTime::now().toSec(), p.x, p.y, p.z, o.x, o.y, o.z, o.w);
   } catch (const InvalidInput& e) {
@@ -91,8 +94,8 @@ void MonitorNode::reportRobotsMissing() {
   if (missing.empty()) return;
   std::string topics;
   for (int i : missing) topics += (topics.empty() ? "" : ", ") + odomSubs_[static_cast<std::size_t>(i)].getTopic();
-  ROS_WARN("monitor: waiting for the robots' odometry: %s on %s; the robots are not measured (not in shape) until "
-           "every one is heard", what, topics.c_str());
+  ROS_WARN("monitor: waiting for the robots' odometry: %s on %s%s; the robots are not measured (not in shape) until "
+           "every one is heard", what, topics.c_str(), odomFrames_->refusedNote().c_str());
   robotsReportedAt_ = ros::WallTime::now();
 }
 
@@ -104,7 +107,7 @@ std::string MonitorNode::robotsResultLines() const {
   out << "robots_in_shape_step: " << robots.convergedStep << "\nrobots_max_distance_error: "
       << robots.findings.maxEdgeError << "\nrobots_shape_error: " << robots.findings.shapeError
       << "\nrobots: " << yamlQuoted(robots.line) << "\nagents_converged_step: " << agents.convergedStep
-      << "\nodometry_dropped: " << badOdometry_ << "\n";
+      << "\nodometry_dropped: " << badOdometry_ << "\nodometry_refused_frame: " << odomFrames_->refused() << "\n";
   return out.str();
 }
 

@@ -12,6 +12,7 @@
 #include "variational_formation/ros/output_files.hpp"
 #include "variational_formation/ros/parameters.hpp"
 #include "variational_formation/ros/frames.hpp"
+#include "variational_formation/ros/markers.hpp"
 #include "variational_formation/ros/world_contact.hpp"
 #include "variational_formation/ros/world_markers.hpp"
 #include "variational_formation/world/mjcf_model.hpp"
@@ -74,6 +75,7 @@ MujocoWorldNode::MujocoWorldNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh
   }
   const Scenario scenario = loadScenario(scenarioFile);
   const int count = scenario.agentCount();
+  agentRadius_ = agentSphereRadius(makeFormation(scenario));
   if (model.empty()) {
     const std::vector<PlanarPose> starts = worldStartPoses(scenario, settings, static_cast<std::uint64_t>(headingSeed));
     world_ = std::make_unique<MujocoWorld>(buildWorldMjcf(settings, starts, worldObstacles(scenario)),
@@ -192,7 +194,7 @@ void MujocoWorldNode::publish() {
   }
   // The bodies, headings and contacts for rviz and render_bag.py, at their own (lower) rate.
   if (markerPeriod_ > 0.0 && world_->time() >= nextMarkers_) {
-    markerPub_.publish(makeWorldMarkers(*world_, header));
+    markerPub_.publish(makeWorldMarkers(*world_, header, agentRadius_));
     nextMarkers_ = world_->time() + markerPeriod_ - 0.5 * world_->settings().timeStep;
   }
 }

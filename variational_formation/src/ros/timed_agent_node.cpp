@@ -198,7 +198,8 @@ void TimedAgentNode::onTick() {
     }
   }
   if (robot_ && !link_->measured()) {
-    ROS_WARN_THROTTLE(kReportEvery, "%s: holding: no odometry on %s yet", name_.c_str(), odomSub_.getTopic().c_str());
+    ROS_WARN_THROTTLE(kReportEvery, "%s: holding: no odometry on %s yet%s", name_.c_str(), odomSub_.getTopic().c_str(),
+                      odomFrames_->refusedNote().c_str());
     return;
   }
   if (!running_ && exitStatus_ < 0 && secondsSince(lastPublishAt_) > 0.25 * agent_->maxAge()) {

@@ -20,7 +20,9 @@ void TimedAgentNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
   } else if (!running_) {
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "waiting for the monitor to start the run");
   } else if (robot_ && !link_->measured()) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "holding: no odometry yet");
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                   odomFrames_->refused() > 0 ? "holding: no odometry in the world frame '" + worldFrame_ + "' yet"
+                                              : std::string("holding: no odometry yet"));
   } else if (agent_->holding()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "holding: a neighbour is silent");
   } else {
@@ -46,6 +48,7 @@ void TimedAgentNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
     status.add("cmd_vel sent", link_->commands());
     status.add("cmd_vel saturated (scaled down to max_speed, max_turn_rate)", link_->saturatedCommands());
     status.add("odometry dropped (malformed)", badOdometry_);
+    status.add("odometry refused (not in the world frame)", odomFrames_->refused());
     status.add("robot lag + tick [s]", lagCheck_.lagPlusTick);
     status.add("delay margin [s]", lagCheck_.capped ? -1.0 : lagCheck_.marginSeconds);  // -1: none found
     status.add("lag exceeds the delay margin", lagCheck_.exceeded);

@@ -27,6 +27,8 @@ void TimedAgentNode::setUpRobot(ros::NodeHandle& nh, ros::NodeHandle& pnh, const
   // Public topics in the robot's namespace, relative to the formation's: a robot driver's names.
   const std::string robotNs = optionalParam<std::string>(pnh, "robot_namespace", "robot_" + std::to_string(id));
   const std::string in = robotNs.empty() ? "" : robotNs + "/";
+  odomFrames_ = std::make_unique<FrameGate>(worldFrame_, name_, "the agent holds until odometry in '" + worldFrame_ +
+                                                                    "' comes");
   odomSub_ = nh.subscribe(in + "odom", 10, &TimedAgentNode::onOdometry, this, ros::TransportHints().tcpNoDelay());
   setpointPub_ = nh.advertise<geometry_msgs::PoseStamped>(in + "setpoint", 10);
   cmdVelPub_ = nh.advertise<geometry_msgs::Twist>(in + "cmd_vel", 10);
@@ -42,6 +44,7 @@ void TimedAgentNode::onOdometry(const nav_msgs::Odometry& odom) {
   const auto& p = odom.pose.pose.position;
   const auto& o = odom.pose.pose.orientation;
   const bool first = !link_->measured();
+  if (!odomFrames_->admit(odom.header.frame_id, odomSub_.getTopic())) return;
   try {
     link_->measureOdometry(p.x, p.y, p.z, o.x, o.y, o.z, o.w);
   } catch (const InvalidInput& e) {

@@ -50,7 +50,8 @@ Marker spheres(const std_msgs::Header& header, const std::string& ns, const Poin
 
 }  // namespace
 
-visualization_msgs::MarkerArray makeWorldMarkers(const MujocoWorld& world, const std_msgs::Header& header) {
+visualization_msgs::MarkerArray makeWorldMarkers(const MujocoWorld& world, const std_msgs::Header& header,
+                                                 double agentRadius) {
   visualization_msgs::MarkerArray out;
   for (int i = 0; i < world.robotCount(); ++i) {
     const BodyOutline b = world.bodyOutline(i);
@@ -58,17 +59,16 @@ visualization_msgs::MarkerArray makeWorldMarkers(const MujocoWorld& world, const
     body.pose.position = point(b.x, b.y, b.z);
     body.scale.x = body.scale.y = 2.0 * b.radius;
     body.scale.z = 2.0 * b.halfHeight;
-    body.color = agentColour(i);
-    body.color.a = 0.5f;
+    body.color = agentColour(i);  // solid: it shows through its agent's halo (AgentSpheres::Halos)
     out.markers.push_back(body);
     const PlanarPose p = world.pose(i);
     Marker heading = marker(header, "headings", i, Marker::ARROW);
-    const double top = b.z + b.halfHeight + 0.01, length = 2.0 * b.radius;
+    const double top = b.z + b.halfHeight + 0.01, reach = std::max(b.radius, agentRadius), length = 2.0 * reach;
     heading.points = {point(p.x, p.y, top),
                       point(p.x + length * std::cos(p.heading), p.y + length * std::sin(p.heading), top)};
-    heading.scale.x = 0.2 * b.radius;  // shaft diameter
-    heading.scale.y = 0.4 * b.radius;  // head diameter
-    heading.scale.z = 0.5 * b.radius;  // head length
+    heading.scale.x = 0.2 * reach;  // shaft diameter
+    heading.scale.y = 0.4 * reach;  // head diameter
+    heading.scale.z = 0.5 * reach;  // head length
     heading.color = rgba(0.95, 0.95, 0.95, 1.0);
     out.markers.push_back(heading);
   }

@@ -41,7 +41,8 @@ int runScenarioInfoCli(int argc, const char* const* argv, std::ostream& out, std
       err << "scenario_info: graph: " << rigidity.summary() << '\n';
       if (rigidity.rigidityClass != RigidityClass::GloballyRigid) {
         err << "scenario_info: warning: the graph is not globally rigid: the formation can settle in another "
-               "shape with every edge at its length (make_scenario --graph knn builds one that is)\n";
+               "shape with every edge at its length (make_scenario --graph complete builds one that is; "
+               "doc/scenarios.md says when knn is better)\n";
       }
     }
     out << "agents " << s.agentCount() << '\n';

@@ -21,12 +21,12 @@ namespace vf {
 namespace {
 
 const char* kUsage =
-    "usage: simulate --scenario FILE|NAME --out traj.csv [--metrics metrics.csv]\n"
+    "usage: simulate --scenario FILE|NAME [--out traj.csv] [--metrics metrics.csv]\n"
     "                [--method vi|euler|rk4] [--init variational|paper (vi only)]\n"
     "                [--time-step H] [--steps N] [--kappa K]\n"
     "                [--delay-steps D] [--loss P [--seed S]]   (vi only)\n"
     "                [--commands FILE.csv]   (vi only; replaces the scenario's manoeuvre)\n"
-    "Runs a formation scenario centrally. traj.csv: step,t,agent,x,y,z;\n"
+    "Runs a formation scenario centrally and says how it ended. traj.csv: step,t,agent,x,y,z;\n"
     "metrics.csv: step,t,energy,max_distance_error,px,py,pz,ax,ay,az,cvx,cvy,cvz,wx,wy,wz,scale_error,\n"
     "shape_error (and min_separation under a scenario's safety: filter). The last line on stdout says\n"
     "how the formation ended: 'formation: converged to the desired shape ...' or 'formation: not\n"
@@ -96,7 +96,6 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
       return kExitOk;
     }
     args.require("--scenario");
-    args.require("--out");
     const Method method = parseMethod(args.text("--method", "vi"));
     const StartMethod start = parseStartMethod(args.text("--init", "variational"));
     if (args.has("--init") && method != Method::Variational) {
@@ -124,11 +123,12 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
     for (const std::string& w : scenario.warnings) err << "simulate: warning: " << w << '\n';
     if (scenario.autoAssignment) out << "assignment: " << scenario.assignment.describe() << '\n';
 
-    std::ofstream traj = openOutput("--out", args.text("--out"));
-    std::ofstream metrics;
-    const bool withMetrics = args.has("--metrics");
+    // Without --out only the lines on stdout: how the run ended.
+    std::ofstream traj, metrics;
+    const bool withTrajectory = args.has("--out"), withMetrics = args.has("--metrics");
+    if (withTrajectory) traj = openOutput("--out", args.text("--out"));
     if (withMetrics) metrics = openOutput("--metrics", args.text("--metrics"));
-    writeTrajectoryHeader(traj);
+    if (withTrajectory) writeTrajectoryHeader(traj);
     const bool safety = scenario.safety.has_value();
     if (withMetrics) writeMetricsHeader(metrics, safety);
     long divergedAt = -1;
@@ -141,8 +141,7 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
     // means anything, and no check of the run is made on it.
     const auto observe = [&](const Integrator& integrator) {
       const long k = integrator.stepIndex();
-      writeTrajectoryRows(traj, integrator.stepIndex(), integrator.time(),
-                          integrator.positions());
+      if (withTrajectory) writeTrajectoryRows(traj, integrator.stepIndex(), integrator.time(), integrator.positions());
       if (withMetrics) {
         writeMetricsRow(metrics, measure(integrator, shapeErrorMeasuredAt(k, formation.agentCount(), scenario.steps)),
                         safety);
@@ -161,9 +160,9 @@ int runSimulateCli(int argc, const char* const* argv, std::ostream& out, std::os
     } else {
       runCentralised(scenario, method, start, manoeuvre ? &schedule : nullptr, observe);
     }
-    traj.flush();
+    if (withTrajectory) traj.flush();
     if (withMetrics) metrics.flush();
-    if (!traj || (withMetrics && !metrics)) {
+    if ((withTrajectory && !traj) || (withMetrics && !metrics)) {
       err << "simulate: error: writing the output failed (disk full?)\n";
       return kExitFailure;
     }

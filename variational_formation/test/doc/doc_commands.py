@@ -102,6 +102,20 @@ def program_sources(name, programs):
     return files + ([cli] if os.path.isfile(cli) else [])
 
 
+def required_options(name, sources):
+    """The options every form of a program's usage line requires (those outside [...]), from the
+    usage text in its sources: `usage: NAME ...` and each further form `   NAME ...`."""
+    forms = re.findall(r'["\']\s*(?:usage:\s*)?' + re.escape(name) + r' ([^"\'\\]*)', sources)
+    required = None
+    for form in forms:
+        bare = form
+        while re.search(r"\[[^\[\]]*\]", bare):
+            bare = re.sub(r"\[[^\[\]]*\]", "", bare)
+        options = set(re.findall(r"--[\w-]+", bare))
+        required = options if required is None else required & options
+    return required or set()
+
+
 def own_launch_files():
     return {os.path.basename(p): p for p in glob.glob(os.path.join(ROOT, "launch", "**", "*.launch"), recursive=True)}
 

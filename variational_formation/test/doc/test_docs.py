@@ -11,6 +11,11 @@
 - A default the code gives as a plain literal is one of the defaults the document gives.
 - Every node executable, nodelet and node script of the package has a section there, and each
   <param> a launch file gives one of its nodes is listed in that node's section.
+- Every launch file has a section in doc/ros_api.md's "Launch files" that names each of its
+  arguments (every <arg> of the file's own that has no fixed value); a table of arguments names
+  only arguments the file has, and gives each plain default (not a $(...) expression) the file gives.
+- What the pages show scenario_info printing (a console block's `$ rosrun ... scenario_info`
+  and the lines after it) is what it prints: its advice and the pages' stay the same.
 - Every relative link in README.md and doc/*.md reaches an existing file and heading.
 - No other page keeps a parameter table of its own (one list), and README.md has at most 200
   lines.
@@ -18,7 +23,10 @@
   tools, and the package of each `rosrun PKG EXE` and `roslaunch PKG FILE`, come from a Debian
   package that package.xml's keys install (scripts/debian_packages.txt, with its dependencies),
   the executable or launch file exists, and this package's programs, launch files and
-  run_formation.sh take the options and arguments the command gives them.
+  run_formation.sh take the options and arguments the command gives them, and a command that
+  gives a value to one of the options the program's usage line requires gives them all (prose
+  about an option, `simulate --out`, gives none). A tool of the package named bare in prose
+  (`simulate --scenario x.yaml`) is checked as its rosrun command.
 - No file of the repository refers to a file outside it (the docs stand alone).
 
   test_docs.py [--gtest_output=xml:PATH]     (rosunit; --text for a plain run)
@@ -27,6 +35,7 @@ import ast
 import os
 import re
 import shutil
+import subprocess
 import sys
 import unittest
 
@@ -488,6 +497,56 @@ class Docs(unittest.TestCase):
         self.assertGreater(checked, 20, "implausibly few launch parameters found")
         self.assertEqual(wrong, [], "\n".join(wrong))
 
+    def test_launch_arguments_are_documented(self):
+        text = read(API)
+        sections = dict(re.findall(r"^### (\S+)\n(.*?)(?=^##)", text[text.index("\n## Launch files"):] + "\n##",
+                                   re.M | re.S))
+        wrong, checked = [], 0
+        for folder, _, names in os.walk(os.path.join(ROOT, "launch")):
+            for launch in sorted(n for n in names if n.endswith(".launch")):
+                path = os.path.join(folder, launch)
+                key = os.path.relpath(path, os.path.join(ROOT, "launch"))
+                section = sections.get(key)
+                if section is None:
+                    wrong.append(f"{relative(path)}: no section '### {key}' under 'Launch files' in doc/ros_api.md")
+                    continue
+                args = {a.get("name"): a.get("default") for a in doc_commands.ElementTree.parse(path).getroot()
+                        if a.tag == "arg" and a.get("value") is None}
+                named = set(re.findall(r"`([\w/]+)`", section))
+                wrong += [f"{relative(path)}: argument {a} is not in its section of doc/ros_api.md"
+                          for a in sorted(set(args) - named)]
+                checked += len(args)
+                for row in re.findall(r"^\| (`.*?) \| (.*?) \|", section, re.M):
+                    for name in re.findall(r"`(\w+)`", row[0]):
+                        default = args.get(name)
+                        if name not in args:
+                            wrong.append(f"doc/ros_api.md, {key}: `{name}` is not an argument of {relative(path)}")
+                        elif default is not None and "$(" not in default and default not in row[1].replace("`", ""):
+                            wrong.append(f"doc/ros_api.md, {key}: `{name}`: the file's default is '{default}', "
+                                         f"the table says '{row[1]}'")
+        self.assertGreater(checked, 60, "implausibly few launch arguments found")
+        self.assertEqual(wrong, [], "\n".join(wrong))
+
+    def test_quoted_scenario_info_output_is_the_tools(self):
+        import roslib.packages
+        tool = roslib.packages.find_node(doc_commands.PKG, "scenario_info")
+        self.assertTrue(tool, "scenario_info is not built")
+        fence = re.compile(r"^```console\n(.*?)^```", re.M | re.S)
+        compared = 0
+        for page in doc_commands.pages():
+            for block in fence.findall(read(page)):
+                parts = re.split(r"^\$ ", block, flags=re.M)[1:]
+                for part in parts:
+                    command, *shown = part.rstrip("\n").split("\n")
+                    words = command.split()
+                    if words[:3] != ["rosrun", doc_commands.PKG, "scenario_info"]:
+                        continue
+                    result = subprocess.run(tool[:1] + words[3:], capture_output=True, text=True, timeout=60, cwd=REPOSITORY)
+                    compared += 1
+                    self.assertEqual(shown, (result.stderr + result.stdout).splitlines(),
+                                     f"{relative(page)}: what `{command}` prints")
+        self.assertGreater(compared, 0, "no quoted scenario_info output found")
+
     def test_one_parameter_list(self):
         pages = [os.path.join(REPOSITORY, "README.md")] + [
             os.path.join(REPOSITORY, "doc", n) for n in sorted(os.listdir(os.path.join(REPOSITORY, "doc"))) if n.endswith(".md")]
@@ -530,7 +589,10 @@ class Docs(unittest.TestCase):
         documented = set(self.doc.specs) | set(self.doc.references)
         wrong, checked, provided = [], 0, []  # provided: (where, what, path) to look up in dpkg
 
+        tools = {name for name in programs if os.path.isfile(os.path.join(ROOT, "src", "tools", name + "_cli.cpp"))}
         for where, words in doc_commands.every_command():
+            if words[0] in tools:  # a tool named bare in prose: `simulate --scenario deploy6.yaml`
+                words = ["rosrun", doc_commands.PKG] + words
             tool = words[0]
             if re.fullmatch(r"(ros|catkin)\w*", tool):
                 checked += 1
@@ -590,6 +652,13 @@ class Docs(unittest.TestCase):
         else:
             arguments = None
         sources = "".join(read(p) for p in doc_commands.program_sources(name, programs)) if tool == "rosrun" else ""
+        given = {w.split("=", 1)[0] for w in words[3:]}
+        required = doc_commands.required_options(name, sources) if tool == "rosrun" else set()
+        # A run gives a required option a value; prose about options (`simulate --out`) does not.
+        valued = {w for w, after in zip(words[3:], words[4:]) if w in required and not after.startswith("-")}
+        if valued and not given & {"--help", "-h"}:
+            for option in sorted(required - given):
+                wrong.append(f"{where}: {command}: the required option {option} is missing")
         for word in words[3:]:
             option, assigned = word.split("=", 1)[0], word.split(":=", 1)[0]
             if option.startswith("--") and f'"{option}"' not in sources and f"'{option}'" not in sources:

@@ -21,7 +21,9 @@ With `mujoco` (render.test kind:=mujoco), the bag of robots.launch world:=mujoco
 the same checks, and the bag holds the world's markers at 20 Hz from when rosbag record joined them,
 a body and a heading arrow per robot in each, every arrow from the robot's odometry position along
 its heading (the same instant, to 1e-9), and the contact markers deleted (the hexagon's robots
-never touch).
+never touch). The bodies are solid, the arrows on their tops reach out of the agents' spheres,
+which are translucent halos round them (opacity 0.35), and the video's last frame shows the
+bodies' solid colours (of the robots whose colour no other marker has).
 
 VF_TEST_DISPLAY=:N (optional) makes every render use X display :N, and the busy-display case
 N + 1; by default Xvfb picks free ones.
@@ -79,6 +81,28 @@ def proc_stat(pid):
         return int(fields[1]), int(fields[2]), int(fields[19])
     except (OSError, IndexError, ValueError):
         return None
+
+
+# The robots' bodies in the MuJoCo render: the agents' colours that no other marker of that
+# render has (the tf axes are red, green and blue, converged edges green): orange, purple, cyan.
+UNSHARED_COLOURS = (3, 4, 5)
+BODY_PIXELS = 8  # a body 0.21 m across covers about 40 pixels of the 640x480 fit view; measured 17 to 85
+
+
+def solid_pixels(image):
+    """Per colour of PALETTE, the pixels of an RGB image in [0, 1] that show it solid: its hue
+    (within 0.02, the nearest of PALETTE's), saturation above 0.7, and at least half its
+    brightness (HSV value). A halo (opacity 0.35) over rviz's dark background has neither: it
+    blends with the grey."""
+    import colorsys
+
+    import matplotlib.colors
+    hsv = matplotlib.colors.rgb_to_hsv(image[:, :, :3])
+    own = [colorsys.rgb_to_hsv(*rgb) for rgb in vf_rostest.PALETTE]
+    distance = np.stack([np.minimum(abs(hsv[:, :, 0] - h), 1 - abs(hsv[:, :, 0] - h)) for h, _, _ in own])
+    nearest, close = distance.argmin(axis=0), distance.min(axis=0) < 0.02
+    return [int((close & (nearest == k) & (hsv[:, :, 1] > 0.7) & (hsv[:, :, 2] > 0.5 * v)).sum())
+            for k, (_, _, v) in enumerate(own)]
 
 
 class Watched:
@@ -368,15 +392,28 @@ class RenderRobotsTest(RecordedHexagon):
                              capture_output=True, check=True).stdout
         frames = np.frombuffer(raw, dtype=np.uint8).reshape(-1, HEIGHT, WIDTH, 3)
         # The markers of the run throughout: rviz may draw the first picture's markers a frame late.
-        without = [k for k, frame in enumerate(frames)
-                   if min(vf_rostest.agent_colour_pixels(frame / 255.0)) <= 30]
-        self.assertLessEqual(len(without), 0.1 * len(frames), f"frames without every agent's colour: {without}")
+        counts = [vf_rostest.agent_colour_pixels(frame / 255.0) for frame in frames]
+        without = [k for k, c in enumerate(counts) if min(c) <= 30]
+        self.assertLessEqual(len(without), 0.1 * len(frames),
+                             f"frames without every agent's colour: {[(k, counts[k]) for k in without]}")
         self.assertNotIn(len(frames) - 1, without, "the last frame lacks an agent")
+        self.check_last_frame(frames[-1] / 255.0)
+
+    def check_last_frame(self, image):
+        """More checks of the video's last picture (RGB in [0, 1]), by the kind of bag."""
 
 
 class RenderMujocoTest(RenderRobotsTest):
     """RenderRobotsTest on robots.launch world:=mujoco (unicycles), plus the world's markers (its
     setUpClass, reported as there)."""
+
+    def check_last_frame(self, image):
+        # Each robot's body, solid in its agent's colour inside that agent's translucent halo, is
+        # in the picture (the colours of other markers too left aside).
+        solid = solid_pixels(image)
+        for k in UNSHARED_COLOURS:
+            self.assertGreaterEqual(solid[k], BODY_PIXELS,
+                                    f"robot {k}'s body ({vf_rostest.PALETTE[k]}) is not in the last frame: {solid}")
 
     def test_the_bag_holds_the_worlds_markers(self):
         import rosbag
@@ -405,6 +442,13 @@ class RenderMujocoTest(RenderRobotsTest):
                 spaces.setdefault(m.ns, []).append(m)
             self.assertEqual(sorted(m.id for m in spaces["bodies"]), list(range(6)))
             self.assertEqual(sorted(m.id for m in spaces["headings"]), list(range(6)))
+            self.assertEqual({m.color.a for m in spaces["bodies"]}, {1.0}, "the bodies are drawn solid")
+            for body, arrow in zip(sorted(spaces["bodies"], key=lambda m: m.id),
+                                   sorted(spaces["headings"], key=lambda m: m.id)):
+                self.assertGreater(arrow.points[0].z, body.pose.position.z + body.scale.z / 2, "arrow on the body")
+                # Out of the agent's sphere (radius 0.3 m on the side-3 hexagon): twice its radius.
+                self.assertAlmostEqual(np.hypot(arrow.points[1].x - arrow.points[0].x,
+                                                arrow.points[1].y - arrow.points[0].y), 0.6, places=9)
             # The hexagon's robots never touch: the contact markers stay deleted.
             self.assertEqual({m.action for m in spaces["touching"] + spaces["contacts"]}, {m.DELETE})
             for arrow in spaces["headings"]:
@@ -418,6 +462,11 @@ class RenderMujocoTest(RenderRobotsTest):
                 heading = np.arctan2(end.y - start.y, end.x - start.x)
                 self.assertAlmostEqual(float(np.angle(np.exp(1j * (heading - pose[2])))), 0.0, places=9)
         self.assertGreater(compared, 0.9 * 6 * len(arrays), "heading arrows compared with the odometry")
+        # The monitor of a robot run draws its agents as halos round the bodies (opacity 0.35).
+        with rosbag.Bag(self.bag) as bag:
+            halos = {round(c.a, 6) for _, msg, _ in bag.read_messages(topics=["/formation/markers"])
+                     for m in msg.markers if m.ns == "agents" for c in m.colors}
+        self.assertEqual(halos, {0.35}, "the agents' opacity in a robot run")
 
 
 if __name__ == "__main__":

@@ -222,6 +222,7 @@ class RobotsRun(unittest.TestCase):
         self.assertGreaterEqual(robots, 0, r)
         self.assertEqual(int(r["converged_step"]), max(robots, agents), r)
         self.assertEqual(r["odometry_dropped"], 0)
+        self.assertEqual(r["odometry_refused_frame"], 0)  # the robots' odometry is in the world frame
         desired = self.desired()
         # In shape: every pair within 1% of its desired distance, so every edge within 1% of the longest.
         longest = max(math.dist(desired[a], desired[b]) for a, b in self.scenario["edges"])

@@ -105,6 +105,26 @@ TEST_F(MarkersTest, AgentsAreOneSphereListOfTheirPositionsAndColours) {
   }
 }
 
+// A robot run (the monitor's ~measure_robots): the same spheres as translucent halos, so that the
+// robots' bodies inside them (the world's solid markers) show; nothing else changes.
+TEST_F(MarkersTest, RobotRunsDrawTheAgentsAsHalos) {
+  const Formation f = ring(6);
+  Trails trails(6, 100);
+  for (long k = 0; k <= 40; ++k) trails.add(k, positionsAt(f, k));
+  const auto solid = makeMarkers(snapshotAt(f, 40), f, trails);
+  const auto halos = makeMarkers(snapshotAt(f, 40), f, trails, nullptr, 0.0, MarkerParts::All, AgentSpheres::Halos);
+  const Marker& agents = find(halos, "agents", 0);
+  ASSERT_EQ(agents.colors.size(), 6u);
+  for (int i = 0; i < 6; ++i) expectColour(agents.colors[i], agentColour(i), kHaloAlpha, "agent " + std::to_string(i));
+  EXPECT_LE(kHaloAlpha, 0.5f);
+  EXPECT_EQ(agents.points, find(solid, "agents", 0).points);
+  EXPECT_EQ(agents.scale.x, find(solid, "agents", 0).scale.x);
+  ASSERT_EQ(halos.markers.size(), solid.markers.size());
+  for (std::size_t k = 0; k < solid.markers.size(); ++k) {
+    if (solid.markers[k].ns != "agents") EXPECT_EQ(halos.markers[k].colors, solid.markers[k].colors) << solid.markers[k].ns;
+  }
+}
+
 TEST_F(MarkersTest, EdgesAreOneLineListTailThenHeadColouredByTheirError) {
   const int n = 300;
   const Formation f = ring(n);

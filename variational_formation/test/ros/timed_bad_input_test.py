@@ -5,18 +5,23 @@ on stderr naming the field and the value. Odometry that is not a pose (a NaN, a 
 not a rotation), sent by this test's own node, is dropped, counted and warned about by a
 robot-mode agent, which stays up. A monitor measuring robots (~measure_robots) refuses bad settings
 in one line, and drops such odometry the same way, names the robots whose odometry it waits for,
-and stays up."""
+and stays up. Odometry in another frame than the world frame (a TurtleBot3's own odom, each robot
+at 0, 0 of its own frame) is refused with one WARN naming both frames and counted, by the agent
+(which holds; its diagnostics count it), the monitor (which does not measure that robot) and
+odom_starts.py (which waits on, then fails with the count)."""
 import contextlib
 import os
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 import unittest
 
 import rospkg
 import rospy
 import rostest
+from diagnostic_msgs.msg import DiagnosticArray
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Log
 
@@ -42,6 +47,23 @@ def robot_agent(ns, *params):
         p.send_signal(signal.SIGINT)
         p.wait(timeout=20)
         sub.unregister()
+
+
+def odometry(frame, x=0.0, y=0.0):
+    """A pose at (x, y), heading 0, in `frame`."""
+    msg = Odometry()
+    msg.header.frame_id = frame
+    msg.header.stamp = rospy.Time.now()
+    msg.pose.pose.position.x, msg.pose.pose.position.y = x, y
+    msg.pose.pose.orientation.w = 1.0
+    return msg
+
+
+def wait_for_subscriber(test, pub, who):
+    end = time.time() + 20
+    while pub.get_num_connections() == 0 and time.time() < end:
+        time.sleep(0.1)
+    test.assertEqual(pub.get_num_connections(), 1, f"{who} never subscribed to {pub.resolved_name}")
 
 
 def run(command):
@@ -121,14 +143,9 @@ class TimedBadInput(unittest.TestCase):
     def test_malformed_odometry_is_dropped_counted_and_warned(self):
         pub = rospy.Publisher("/odd_robot/odom", Odometry, queue_size=10)
         with robot_agent("/odd", "_kinematics:=unicycle", "_robot_namespace:=/odd_robot") as (p, lines):
-            end = time.time() + 20
-            while pub.get_num_connections() == 0 and time.time() < end:
-                time.sleep(0.1)
-            self.assertEqual(pub.get_num_connections(), 1, "the agent never subscribed to /odd_robot/odom")
-            nan = Odometry()
-            nan.pose.pose.position.x = float("nan")
-            nan.pose.pose.orientation.w = 1.0
-            squashed = Odometry()  # quaternion of norm 0.5: not a rotation
+            wait_for_subscriber(self, pub, "the agent")
+            nan = odometry("world", x=float("nan"))
+            squashed = odometry("world")  # quaternion of norm 0.5: not a rotation
             squashed.pose.pose.orientation.w = 0.5
             for _ in range(3):
                 pub.publish(nan)
@@ -146,6 +163,61 @@ class TimedBadInput(unittest.TestCase):
                         [m.msg for m in lines])
         self.assertFalse(any("first odometry" in m.msg for m in lines), [m.msg for m in lines])
 
+    def test_odometry_in_another_frame_is_refused_once_counted_and_the_agent_holds(self):
+        # A TurtleBot3's own odometry: frame odom, the robot at 0, 0 of it.
+        pub = rospy.Publisher("/tb3_0/odom", Odometry, queue_size=10)
+        diagnostics = []
+        sub = rospy.Subscriber("/diagnostics", DiagnosticArray, lambda m: diagnostics.extend(
+            {kv.key: kv.value for kv in s.values} for s in m.status if s.hardware_id == "foreign/agent_0"),
+            queue_size=100)
+        try:
+            with robot_agent("/foreign", "_kinematics:=unicycle", "_robot_namespace:=/tb3_0") as (p, lines):
+                wait_for_subscriber(self, pub, "the agent")
+                for _ in range(10):
+                    pub.publish(odometry("odom"))
+                    time.sleep(0.2)
+                time.sleep(6.0)  # a diagnostics update and a "holding" line after the last one
+                self.assertIsNone(p.poll(), "the agent ended on odometry in another frame")
+                said = [m.msg for m in lines]
+                refused = [m for m in said if "refused odometry on /tb3_0/odom" in m]
+                self.assertEqual(len(refused), 1, said)
+                self.assertIn("in frame 'odom', not the world frame 'world'", refused[0])
+                self.assertIn("the agent holds", refused[0])
+                self.assertEqual(diagnostics[-1]["odometry refused (not in the world frame)"], "10", diagnostics[-1])
+                # It holds: nothing was taken for a pose.
+                self.assertFalse(any("first odometry" in m for m in said), said)
+                self.assertTrue(any("no odometry on /tb3_0/odom yet (10 refused: not in the world frame 'world')" in m
+                                    for m in said), said)
+                # The world frame, written as tf1 did ("/world"), is taken.
+                pub.publish(odometry("/world", 1.0, 2.0))
+                end = time.time() + 10
+                while not any("first odometry" in m.msg for m in lines) and time.time() < end:
+                    time.sleep(0.1)
+                self.assertTrue(any("first odometry on /tb3_0/odom" in m.msg for m in lines), [m.msg for m in lines])
+        finally:
+            sub.unregister()
+
+    def test_odom_starts_refuses_another_frame(self):
+        pubs = [rospy.Publisher(f"/starts/robot_{i}/odom", Odometry, queue_size=1, latch=True) for i in range(6)]
+        for i, pub in enumerate(pubs):
+            pub.publish(odometry("odom" if i == 0 else "world", float(i), 0.5))
+        out = os.path.join(tempfile.mkdtemp(prefix="odom_starts_"), "starts.csv")
+        command = ["rosrun", vf_rostest.PKG, "odom_starts.py", "--scenario", HEXAGON, "--ns", "/starts", "--out", out,
+                   "--timeout", "4"]
+        status, lines = run(command)
+        self.assertEqual(status, 2, lines)
+        self.assertEqual(len(lines), 2, lines)
+        self.assertIn("warning: refused odometry on /starts/robot_0/odom in frame 'odom', not the world frame 'world'",
+                      lines[0])
+        self.assertIn("error: no odometry in the world frame 'world' on /starts/robot_0/odom within 4 s "
+                      "(1 refused in frame 'odom')", lines[1])
+        self.assertFalse(os.path.exists(out))
+        pubs[0].publish(odometry("world", 0.0, 0.5))
+        status, lines = run(command)
+        self.assertEqual((status, lines), (0, []))
+        with open(out) as f:
+            self.assertEqual(f.read().splitlines(), ["agent,x,y,z"] + [f"{i},{float(i)!r},0.5,0.0" for i in range(6)])
+
     def monitor(self, name, **params):
         base = {"scenario": HEXAGON, "mode": "timed", "real_time_factor": "1", "measure_robots": "true"}
         base.update(params)
@@ -158,31 +230,33 @@ class TimedBadInput(unittest.TestCase):
         self.check(self.monitor("monitor_hand", kinematics="unicycle", hand_offset="-0.1"), "hand_offset", "-0.1")
         self.check(self.monitor("monitor_window", robots_window="0"), "robots_window", "0")
 
-    def test_monitor_drops_bad_odometry_and_names_the_robots_it_waits_for(self):
-        # A timed monitor measuring unicycles, without agents; robot_0's odometry is not a pose, the
-        # other robots never publish.
+    def monitor_sent(self, ns, messages, *params):
+        """A timed monitor measuring robots in `ns`, without agents, sent `messages` on robot_0's
+        odometry (the other robots never publish); its /rosout lines once it has run 6 s (its line
+        about missing robots comes 5 s after the start). It must stay up."""
         lines = []
-        sub = rospy.Subscriber("/rosout", Log, lambda m: lines.append(m.msg) if m.name == "/watch/monitor" else None,
+        sub = rospy.Subscriber("/rosout", Log, lambda m: lines.append(m.msg) if m.name == f"{ns}/monitor" else None,
                                queue_size=1000)
-        pub = rospy.Publisher("/watch/robot_0/odom", Odometry, queue_size=10)
-        p = subprocess.Popen(["rosrun", vf_rostest.PKG, "monitor", "__name:=monitor", "__ns:=/watch",
-                              f"_scenario:={HEXAGON}", "_mode:=timed", "_real_time_factor:=1", "_measure_robots:=true",
-                              "_kinematics:=unicycle"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        pub = rospy.Publisher(f"{ns}/robot_0/odom", Odometry, queue_size=10)
+        p = subprocess.Popen(["rosrun", vf_rostest.PKG, "monitor", "__name:=monitor", f"__ns:={ns}",
+                              f"_scenario:={HEXAGON}", "_mode:=timed", "_real_time_factor:=1", "_measure_robots:=true"]
+                             + list(params), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         try:
-            end = time.time() + 20
-            while pub.get_num_connections() == 0 and time.time() < end:
-                time.sleep(0.1)
-            self.assertEqual(pub.get_num_connections(), 1, "the monitor never subscribed to /watch/robot_0/odom")
-            nan = Odometry()
-            nan.pose.pose.position.x = float("nan")
-            nan.pose.pose.orientation.w = 1.0
-            pub.publish(nan)
-            time.sleep(6.0)  # the line about missing robots comes 5 s after the start
-            self.assertIsNone(p.poll(), "the monitor ended on bad odometry")
+            wait_for_subscriber(self, pub, "the monitor")
+            for m in messages:
+                pub.publish(m)
+                time.sleep(0.2)
+            time.sleep(6.0)
+            self.assertIsNone(p.poll(), "the monitor ended on the odometry sent")
         finally:
             p.send_signal(signal.SIGINT)
             p.wait(timeout=20)
             sub.unregister()
+        return lines
+
+    def test_monitor_drops_bad_odometry_and_names_the_robots_it_waits_for(self):
+        # A timed monitor measuring unicycles; robot_0's odometry is not a pose.
+        lines = self.monitor_sent("/watch", [odometry("world", x=float("nan"))], "_kinematics:=unicycle")
         dropped = [m for m in lines if "dropped an odometry message on /watch/robot_0/odom" in m]
         self.assertEqual(len(dropped), 1, lines)
         self.assertIn("robot_0: odometry:", dropped[0])
@@ -190,6 +264,17 @@ class TimedBadInput(unittest.TestCase):
         waiting = [m for m in lines if "waiting for the robots' odometry" in m]
         self.assertTrue(waiting, lines)
         self.assertIn("no odometry yet on " + ", ".join(f"/watch/robot_{i}/odom" for i in range(6)), waiting[0])
+
+    def test_monitor_refuses_odometry_in_another_frame(self):
+        lines = self.monitor_sent("/frames", [odometry("odom")] * 3)
+        refused = [m for m in lines if "refused odometry" in m]
+        self.assertEqual(len(refused), 1, lines)
+        self.assertIn("on /frames/robot_0/odom in frame 'odom', not the world frame 'world'", refused[0])
+        # robot_0 is not measured: still among those it waits for, with the count.
+        waiting = [m for m in lines if "waiting for the robots' odometry" in m]
+        self.assertTrue(waiting, lines)
+        self.assertIn("no odometry yet on /frames/robot_0/odom, /frames/robot_1/odom", waiting[0])
+        self.assertIn("(3 refused: not in the world frame 'world')", waiting[0])
 
     def test_missing_odometry_holds_and_says_so(self):
         # A robot-mode agent whose odom topic has no publisher: it stays up, holds, and says so

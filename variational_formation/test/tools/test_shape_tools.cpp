@@ -50,7 +50,8 @@ TEST(ScenarioInfo, SaysTheRigidityClassAndWarnsUnlessGloballyRigid) {
   EXPECT_EQ(hexagon.err,
             "scenario_info: graph: minimally rigid in 2D (6 agents, 9 edges; rigidity rank 9 of 9; 0 self-stresses)\n"
             "scenario_info: warning: the graph is not globally rigid: the formation can settle in another shape with "
-            "every edge at its length (make_scenario --graph knn builds one that is)\n");
+            "every edge at its length (make_scenario --graph complete builds one that is; doc/scenarios.md says when "
+            "knn is better)\n");
   const CliResult ring = run(runScenarioInfoCli, {"--scenario", kConfig + "ring7.yaml"});
   EXPECT_EQ(ring.status, 0);
   EXPECT_EQ(ring.err.rfind("scenario_info: graph: globally rigid in 2D (7 agents, 14 edges", 0), 0u) << ring.err;

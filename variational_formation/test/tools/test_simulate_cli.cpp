@@ -152,6 +152,30 @@ TEST(SimulateCli, InitOnlyAppliesToTheVariationalMethod) {
   }
 }
 
+// README's `simulate --scenario deploy6.yaml`: only how the run ended, the same lines as with
+// --out, and no file; --metrics alone still writes its file, the same as beside --out.
+TEST(SimulateCli, WithoutOutItSaysHowTheRunEndedAndWritesNoTrajectory) {
+  const std::string traj = tempPath("kept_traj.csv"), a = tempPath("metrics_a.csv"), b = tempPath("metrics_b.csv");
+  std::remove(traj.c_str());
+  const CliResult with = simulate({"--scenario", kConfig + "square.yaml", "--steps", "30", "--out", traj,
+                                   "--metrics", a});
+  ASSERT_EQ(with.status, 0) << with.err;
+  std::remove(traj.c_str());
+  const CliResult without = simulate({"--scenario", kConfig + "square.yaml", "--steps", "30", "--metrics", b});
+  ASSERT_EQ(without.status, 0) << without.err;
+  EXPECT_EQ(without.out, with.out);
+  EXPECT_EQ(without.out.rfind("formation: ", without.out.rfind('\n', without.out.size() - 2) + 1),
+            without.out.rfind('\n', without.out.size() - 2) + 1)
+      << without.out;
+  EXPECT_EQ(lines(b), lines(a));
+  EXPECT_EQ(lines(b).size(), 32u);
+  EXPECT_FALSE(std::ifstream(traj).good());
+  const CliResult bare = simulate({"--scenario", kConfig + "square.yaml", "--steps", "30"});
+  EXPECT_EQ(bare.status, 0) << bare.err;
+  EXPECT_EQ(bare.out, with.out);
+  EXPECT_EQ(bare.err, "");
+}
+
 TEST(SimulateCli, HelpExitsZero) {
   const CliResult r = simulate({"--help"});
   EXPECT_EQ(r.status, 0);
@@ -162,7 +186,6 @@ TEST(SimulateCli, BadFlagsAreOneLineErrorsWithStatusTwo) {
   const std::string sc = kConfig + "square.yaml", out = tempPath("x.csv");
   expectBadInput({"--scenario", sc, "--out", out, "--bogus"}, "--bogus: unknown flag");
   expectBadInput({"--scenario", sc, "--out"}, "--out: expects 1 value");
-  expectBadInput({"--scenario", sc}, "--out: required");
   expectBadInput({"--out", out}, "--scenario: required");
   expectBadInput({"--scenario", sc, "--out", out, "--time-step", "abc"}, "--time-step: expected a finite number");
   expectBadInput({"--scenario", sc, "--out", out, "--time-step", "0"}, "--time-step: must be finite and > 0, got 0");

@@ -51,6 +51,7 @@ TEST(WorldMarkers, ShowBodiesHeadingsObstaclesAndContacts) {
     EXPECT_DOUBLE_EQ(body.scale.x, 2.0 * s.bodyRadius);
     EXPECT_EQ(body.color.r, agentColour(i).r);
     EXPECT_EQ(body.color.g, agentColour(i).g);
+    EXPECT_EQ(body.color.a, 1.0f);  // solid, seen through its agent's halo (was 0.5: hidden in the sphere)
     // The arrow runs from the axle along the heading.
     const Marker& arrow = markers["headings"][static_cast<std::size_t>(i)];
     const PlanarPose p = world.pose(i);
@@ -58,6 +59,18 @@ TEST(WorldMarkers, ShowBodiesHeadingsObstaclesAndContacts) {
     EXPECT_DOUBLE_EQ(arrow.points[0].x, p.x);
     EXPECT_DOUBLE_EQ(arrow.points[0].y, p.y);
     EXPECT_NEAR(std::atan2(arrow.points[1].y - p.y, arrow.points[1].x - p.x), p.heading, 1e-12);
+    // On top of the body, where nothing hides it, two body radii long without agent spheres.
+    EXPECT_GT(arrow.points[0].z, body.pose.position.z + 0.5 * body.scale.z);
+    EXPECT_EQ(arrow.points[1].z, arrow.points[0].z);
+    EXPECT_NEAR(std::hypot(arrow.points[1].x - p.x, arrow.points[1].y - p.y), 2.0 * s.bodyRadius, 1e-12);
+  }
+  // Beside agent spheres of radius 0.3 m (the side-3 hexagon's), the arrows reach 0.6 m: out of
+  // the sphere round the robot, as thick as the sphere's scale asks.
+  auto beside = byNamespace(makeWorldMarkers(world, header, 0.3));
+  ASSERT_EQ(beside["headings"].size(), 2u);
+  for (const Marker& arrow : beside["headings"]) {
+    EXPECT_NEAR(std::hypot(arrow.points[1].x - arrow.points[0].x, arrow.points[1].y - arrow.points[0].y), 0.6, 1e-12);
+    EXPECT_NEAR(arrow.scale.x, 0.06, 1e-12);
   }
   // The unicycle's body sits 0.4 radius behind its axle, as the model builds it.
   EXPECT_NEAR(markers["bodies"][0].pose.position.x, -0.4 * s.bodyRadius * std::cos(0.3), 1e-9);

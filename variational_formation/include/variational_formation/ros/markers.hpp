@@ -21,6 +21,10 @@ std_msgs::ColorRGBA rgba(double r, double g, double b, double a);
 /// Colour of agent i in rviz (a fixed palette, so screenshots can be checked).
 std_msgs::ColorRGBA agentColour(int agent);
 
+/// Radius of the agents' spheres [m]: a tenth of the shortest desired edge (1 m without edges),
+/// at least 5 cm; the other markers' sizes follow it.
+double agentSphereRadius(const Formation& formation);
+
 /// Status message of a snapshot.
 FormationStatus toStatusMessage(const FormationSnapshot& snapshot);
 
@@ -28,6 +32,13 @@ FormationStatus toStatusMessage(const FormationSnapshot& snapshot);
 /// every step (agents, edges, text, command arrow). rviz keeps drawing the trails and the ghost of
 /// the last array that held them (a marker stays until replaced or deleted).
 enum class MarkerParts { All, Moving };
+
+/// How the agents' spheres are drawn: solid, or, in a robot run (the monitor's ~measure_robots),
+/// as translucent halos (opacity kHaloAlpha) through which each robot's body and heading, drawn
+/// solid by its world (world_markers.hpp), show: a sphere is a tenth of the shortest desired
+/// distance in radius, 0.3 m on the side-3 hexagon, and a TurtleBot3 Burger's body 0.105 m.
+enum class AgentSpheres { Solid, Halos };
+constexpr float kHaloAlpha = 0.35f;
 
 /// Simulated seconds between two arrays with every marker, at least: 25 a simulated second, as
 /// often as rviz redraws (doc/benchmarks.md, "Recording and pacing").
@@ -68,10 +79,12 @@ long allMarkersEvery(int trailStride, double timeStep);
  * @param schedule the commands the agents apply, or nullptr. @param timeStep h [s].
  * @param parts MarkerParts::Moving leaves out the trails and the ghost (ns `trails` and
  * `desired_shape`).
+ * @param spheres AgentSpheres::Halos: the agents' colours at opacity kHaloAlpha (a robot run).
  */
 visualization_msgs::MarkerArray makeMarkers(const FormationSnapshot& snapshot, const Formation& formation,
                                             const Trails& trails, const CommandSchedule* schedule = nullptr,
-                                            double timeStep = 0.0, MarkerParts parts = MarkerParts::All);
+                                            double timeStep = 0.0, MarkerParts parts = MarkerParts::All,
+                                            AgentSpheres spheres = AgentSpheres::Solid);
 
 /**
  * The safety filter's markers (a scenario with `safety:`), appended to `out`: per agent its safety

@@ -29,6 +29,7 @@
 #include "variational_formation_core/protocol/lockstep_referee.hpp"
 #include "variational_formation_core/protocol/timed_referee.hpp"
 #include "variational_formation_core/protocol/referee_ready.hpp"
+#include "variational_formation/ros/frames.hpp"
 #include "variational_formation/ros/goal_server.hpp"
 #include "variational_formation/ros/service_call.hpp"
 #include "variational_formation/ros/state_batch.hpp"
@@ -258,6 +259,7 @@ class MonitorNode {
   std::unique_ptr<ForeignWatch> foreignWatch_;  // over foreign_
   std::vector<ros::Subscriber> odomSubs_;  // ~measure_robots: robot_<i>/odom
   long badOdometry_ = 0;                   // odometry messages refused (not finite, not a rotation)
+  std::unique_ptr<FrameGate> odomFrames_;  // ~measure_robots: odometry in another frame than worldFrame_
   long reportedRobots_ = -2;               // the robots' in-shape stretch already announced (-2: none)
   ros::WallTime robotsReportedAt_;         // the last line about missing robots
 };

@@ -53,6 +53,7 @@ class MujocoWorldNode {
   bool wheelOdometry_ = false, clock_ = false;
   double publishPeriod_ = 0.01, cmdTimeout_ = 0.5, realTimeFactor_ = 1.0;
   double markerPeriod_ = 0.05, nextMarkers_ = 0.0;  // simulated time [s]; period <= 0: no markers
+  double agentRadius_ = 0.0;  // the monitor's agent spheres [m]: the heading arrows reach out of them
   std::string worldFrame_, resultFile_;
   bool resultWritten_ = false, runOver_ = false;
   long saturated_ = 0, malformed_ = 0;

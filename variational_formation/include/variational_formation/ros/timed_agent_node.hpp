@@ -21,6 +21,7 @@
 #include "variational_formation_core/robots/robot_link.hpp"
 #include "variational_formation_core/agents/timed_agent.hpp"
 #include "variational_formation/ros/foreign_formations.hpp"
+#include "variational_formation/ros/frames.hpp"
 
 namespace vf {
 
@@ -43,7 +44,7 @@ using variational_formation_msgs::RunProgress;
  * namespace ~robot_namespace (default robot_<id>, relative, so remappable like any driver's). The
  * maths of the link (holonomic or unicycle hand point, odometry or integrated feedback) is
  * RobotLink's. It holds until the first odometry; refused odometry (NaN, a quaternion that is not
- * a rotation) is dropped, counted and warned about. At start it compares the robot's lag plus
+ * a rotation, a frame other than the world frame: FrameGate) is dropped, counted and warned about. At start it compares the robot's lag plus
  * one tick with the scenario's delay margin (checkRobotLag): a WARN if the lag exceeds it with
  * odometry feedback, else one INFO line (with integrated feedback the margin does not bound it).
  *
@@ -120,6 +121,7 @@ class TimedAgentNode {
   std::unique_ptr<RobotLink> link_;  // robot mode only
   std::vector<double> start_;         // the position the next tick starts from (robot mode)
   long badOdometry_ = 0;
+  std::unique_ptr<FrameGate> odomFrames_;  // robot mode: odometry in another frame than worldFrame_
   RobotLagCheck lagCheck_;
   bool running_ = false;
   long dropped_ = 0;
