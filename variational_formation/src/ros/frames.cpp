@@ -1,6 +1,5 @@
 #include "variational_formation/ros/frames.hpp"
 
-
 #include "variational_formation_core/common/invalid_input.hpp"
 
 namespace vf {
