@@ -7,6 +7,7 @@ add_library(variational_formation_ros
   src/ros/bag_writer.cpp
   src/ros/formation_subscriptions.cpp
   src/ros/frame_broadcaster.cpp
+  src/ros/frame_gate.cpp
   src/ros/frames.cpp
   src/ros/liveness.cpp
   src/ros/local_states.cpp

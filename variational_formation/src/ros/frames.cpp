@@ -1,6 +1,5 @@
 #include "variational_formation/ros/frames.hpp"
 
-#include <utility>
 
 #include "variational_formation_core/common/invalid_input.hpp"
 
@@ -26,24 +25,6 @@ std::string worldFrame(const ros::NodeHandle& pnh) {
 bool isFrame(const std::string& frame, const std::string& world) {
   const auto bare = [](const std::string& f) { return f.compare(0, 1, "/") == 0 ? f.substr(1) : f; };
   return bare(frame) == bare(world);
-}
-
-FrameGate::FrameGate(std::string worldFrame, std::string who, std::string consequence)
-    : world_(std::move(worldFrame)), who_(std::move(who)), consequence_(std::move(consequence)) {}
-
-bool FrameGate::admit(const std::string& frame, const std::string& topic) {
-  if (isFrame(frame, world_)) return true;
-  ++refused_;
-  if (warned_.insert(topic).second) {
-    ROS_WARN("%s: refused odometry on %s in frame '%s', not the world frame '%s' (positions are taken as world "
-             "positions: remap a pose in '%s' there); %s; every such message is refused and counted",
-             who_.c_str(), topic.c_str(), frame.c_str(), world_.c_str(), world_.c_str(), consequence_.c_str());
-  }
-  return false;
-}
-
-std::string FrameGate::refusedNote() const {
-  return refused_ > 0 ? " (" + std::to_string(refused_) + " refused: not in the world frame '" + world_ + "')" : "";
 }
 
 geometry_msgs::TransformStamped frameAt(const std_msgs::Header& header, const std::string& child,

@@ -121,7 +121,9 @@ TEST_F(MarkersTest, RobotRunsDrawTheAgentsAsHalos) {
   EXPECT_EQ(agents.scale.x, find(solid, "agents", 0).scale.x);
   ASSERT_EQ(halos.markers.size(), solid.markers.size());
   for (std::size_t k = 0; k < solid.markers.size(); ++k) {
-    if (solid.markers[k].ns != "agents") EXPECT_EQ(halos.markers[k].colors, solid.markers[k].colors) << solid.markers[k].ns;
+    if (solid.markers[k].ns != "agents") {
+      EXPECT_EQ(halos.markers[k].colors, solid.markers[k].colors) << solid.markers[k].ns;
+    }
   }
 }
 

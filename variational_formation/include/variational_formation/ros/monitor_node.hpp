@@ -29,6 +29,7 @@
 #include "variational_formation_core/protocol/lockstep_referee.hpp"
 #include "variational_formation_core/protocol/timed_referee.hpp"
 #include "variational_formation_core/protocol/referee_ready.hpp"
+#include "variational_formation/ros/frame_gate.hpp"
 #include "variational_formation/ros/frames.hpp"
 #include "variational_formation/ros/goal_server.hpp"
 #include "variational_formation/ros/service_call.hpp"

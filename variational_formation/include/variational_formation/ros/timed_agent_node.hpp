@@ -21,6 +21,7 @@
 #include "variational_formation_core/robots/robot_link.hpp"
 #include "variational_formation_core/agents/timed_agent.hpp"
 #include "variational_formation/ros/foreign_formations.hpp"
+#include "variational_formation/ros/frame_gate.hpp"
 #include "variational_formation/ros/frames.hpp"
 
 namespace vf {
