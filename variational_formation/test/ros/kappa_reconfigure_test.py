@@ -8,11 +8,12 @@ Timed mode:
   kept value. (Before the fix the cfg's min clamped it to 0 silently.)
 - The formation's server (the monitor's, `/formation`): kappa 6 reaches every agent (each one's
   own server reports 6, each logs that it applies it); -5 there is refused with a WARN from the
-  monitor, and every agent keeps 6.
+  monitor, and every agent keeps 6: a later 7 is the only value after 6 that any agent applies.
 Lockstep mode: the formation's server refuses any change with a WARN saying why (bit for bit
 equal to simulate) and keeps 13; the agents serve no kappa at all.
 """
 import os
+import re
 import subprocess
 import sys
 import time
@@ -42,6 +43,10 @@ def dynparam(*args):
 
 @vf_rostest.reported_setup
 class KappaReconfigure(unittest.TestCase):
+    """What both modes share: the /rosout lines and the servers. Each mode's test is a subclass, and
+    the run takes the one its `~mode` names (the launch passes it as an argument too), so no test
+    passes without checking anything."""
+
     @classmethod
     def setUpClass(cls):
         rospy.init_node("kappa_reconfigure_test")
@@ -75,9 +80,10 @@ class KappaReconfigure(unittest.TestCase):
         status, out = dynparam("set", server, "kappa", value)
         self.assertEqual(status, 0, out)
 
+
+class KappaTimed(KappaReconfigure):
     def test_timed(self):
-        if self.mode != "timed":
-            return
+        self.assertEqual(self.mode, "timed")
         # An agent's own server: refused, not clamped.
         self.set(f"{NS}/agent_1", "-5")
         line = self.wait_for_line(f"{NS}/agent_1", Log.WARN, "~kappa: -5 refused")
@@ -101,13 +107,21 @@ class KappaReconfigure(unittest.TestCase):
         self.assertIn("outside the accepted range [0, ", line)
         self.assertIn("kappa stays 6", line)
         self.assertEqual(self.kappa_of(NS), 6.0)
-        time.sleep(0.5)  # an update would have reached the agents by now
         for i in range(AGENTS):
             self.assertEqual(self.kappa_of(f"{NS}/agent_{i}"), 6.0, f"agent_{i}")
+        # The refused -5 sent nothing: a later 7 takes the same path, and once every agent has
+        # applied it, the agent's kappa lines since the 6 are that 7 alone.
+        self.set(NS, "7")
+        for i in range(AGENTS):
+            self.wait_for_line(f"{NS}/agent_{i}", Log.INFO, "kappa set to 7 from step", "the formation's kappa")
+            applied = [m.group(1) for n, _, t in list(self.lines) if n == f"{NS}/agent_{i}"
+                       for m in [re.search(r"kappa set to (\S+) from step", t)] if m]
+            self.assertEqual(applied, ["6", "7"], f"agent_{i}: the kappa values it applied")
 
+
+class KappaLockstep(KappaReconfigure):
     def test_lockstep(self):
-        if self.mode != "lockstep":
-            return
+        self.assertEqual(self.mode, "lockstep")
         self.set(NS, "6")
         line = self.wait_for_line(f"{NS}/monitor", Log.WARN, f"{NS}/kappa: 6 refused, kappa stays 13",
                                   "bit for bit")
@@ -119,4 +133,8 @@ class KappaReconfigure(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    rostest.rosrun(vf_rostest.PKG, "kappa_reconfigure", KappaReconfigure)
+    MODES = {"timed": KappaTimed, "lockstep": KappaLockstep}
+    mode = [a for a in sys.argv[1:] if a in MODES]
+    if len(mode) != 1:
+        sys.exit(f"kappa_reconfigure_test.py: give the mode as an argument, one of {sorted(MODES)}; got {sys.argv[1:]}")
+    rostest.rosrun(vf_rostest.PKG, "kappa_reconfigure", MODES[mode[0]])

@@ -71,7 +71,10 @@ class LocalDelivery(unittest.TestCase):
         cls.late = Listener(4)
         name = os.path.basename(cls.path).replace(".yaml", "")
         cls.result = vf_rostest.wait_for_result(os.path.join(cls.out, name + ".result.yaml"), 60.0)
-        time.sleep(0.5)  # the last states reach the listeners
+        # The last states reach the listeners (the checks below want every step up to the last).
+        last = lambda: all(l.steps() and l.steps()[-1] >= cls.steps for l in (cls.early, cls.late))  # noqa: E731
+        assert vf_rostest.wait_until(last, 10.0), \
+            f"the listeners' last steps {[l.steps()[-1:] for l in (cls.early, cls.late)]}, not {cls.steps}, 10 s after the result"
         cls.after = {}
         for agent in (0, 5):
             t0 = time.monotonic()

@@ -15,7 +15,6 @@ import math
 import os
 import shutil
 import sys
-import time
 import unittest
 
 import rospy
@@ -42,7 +41,11 @@ class SafetyMonitor(unittest.TestCase):
                           for i in range(cls.scenario["n"])]
         path = os.path.join(cls.out, "blocked_line_timed.result.yaml")
         cls.result = vf_rostest.wait_for_result(path, 45.0)
-        time.sleep(0.5)  # the last status
+        # The last status and every agent's last state (the checks below read both).
+        done = int(cls.result.get("completed_step", -1))
+        arrived = lambda: (cls.status and cls.status[-1].step >= done  # noqa: E731
+                           and all(cls.states.get(i) and cls.states[i][-1].step >= done for i in range(cls.scenario["n"])))
+        assert vf_rostest.wait_until(arrived, 10.0), f"the status and states of step {done} did not arrive in 10 s"
         cls.status_sub.unregister()
         for s in cls.state_subs:
             s.unregister()

@@ -280,10 +280,14 @@ class TimedBadInput(unittest.TestCase):
         # A robot-mode agent whose odom topic has no publisher: it stays up, holds, and says so
         # every few seconds (no monitor either: it would not start anyway).
         with robot_agent("/lonely", "_robot_namespace:=/nobody") as (p, lines):
-            time.sleep(12.0)
+            said = lambda: [m for m in list(lines) if "no odometry on /nobody/odom" in m.msg]  # noqa: E731
+            self.assertTrue(vf_rostest.wait_until(lambda: len(said()) >= 3, 30.0),
+                            f"{len(said())} lines in 30 s: {[m.msg for m in lines]}")
             self.assertIsNone(p.poll(), "the agent ended without odometry")
-        said = [m.msg for m in lines if "no odometry on /nobody/odom" in m.msg]
-        self.assertTrue(2 <= len(said) <= 4, f"{len(said)} lines: {[m.msg for m in lines]}")
+        # Said every 5 s (ROS_WARN_THROTTLE), by the stamps of its lines: not once per tick.
+        stamps = [m.header.stamp.to_sec() for m in said()]
+        gaps = [b - a for a, b in zip(stamps, stamps[1:])]
+        self.assertTrue(all(4.5 <= g <= 7.5 for g in gaps[:2]), f"seconds between the lines: {gaps}")
 
 
 if __name__ == "__main__":

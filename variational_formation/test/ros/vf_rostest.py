@@ -318,6 +318,17 @@ def recorded_with_commands(out, path, timeout):
     return result, os.path.join(out, name + ".bag"), commands, expected
 
 
+def wait_until(condition, timeout, poll=0.01):
+    """Whether `condition()` holds within `timeout` s, looked at every `poll` s: a wait on the
+    condition a test asserts next, instead of a sleep that guesses how long it takes."""
+    end = time.time() + timeout
+    while not condition():
+        if time.time() >= end:
+            return False
+        time.sleep(poll)
+    return True
+
+
 class StepWatcher:
     """The newest completed step on the monitor's status topic, and a wait for a given one. Fault
     tests extend it with what else they follow (each agent's states, log lines)."""
@@ -335,10 +346,7 @@ class StepWatcher:
 
     def wait_for_step(self, step, timeout=60.0):
         """Whether the status reaches `step` within `timeout` s."""
-        end = time.time() + timeout
-        while self.step < step and time.time() < end:
-            time.sleep(self.poll)
-        return self.step >= step
+        return wait_until(lambda: self.step >= step, timeout, self.poll)
 
     def unregister(self):
         for sub in self.subs:
